@@ -1,0 +1,47 @@
+"""The one numba policy of TruOrtho.
+
+All kernels are compiled with the decorators defined here, so caching, GIL
+release and floating-point flags are decided in one place:
+
+* ``cache=True`` with the cache in ``$TRUORTHO_CACHE_DIR/numba`` (default
+  ``~/.cache/truortho/numba``), because the plugin folder may be read-only in
+  a desktop install. An explicit ``NUMBA_CACHE_DIR`` wins.
+* ``nogil=True`` so tiles can run in threads.
+* ``fastmath`` only for :data:`fastjit` kernels whose results are compared
+  statistically (matching costs); geometry kernels stay IEEE-exact so that
+  round trips hold to 1e-9.
+
+Kernels are private functions taking arrays and scalars only (no dicts, no
+I/O, no raising); public wrappers validate their inputs first.
+"""
+
+from __future__ import annotations
+
+import os
+
+
+def _cache_dir() -> str:
+    base = os.environ.get("TRUORTHO_CACHE_DIR") or os.path.join(
+        os.path.expanduser("~"), ".cache", "truortho"
+    )
+    return os.path.join(base, "numba")
+
+
+if not os.environ.get("NUMBA_CACHE_DIR"):
+    os.environ["NUMBA_CACHE_DIR"] = _cache_dir()
+
+import numba  # noqa: E402
+
+if not getattr(numba.config, "CACHE_DIR", ""):
+    numba.config.CACHE_DIR = os.environ["NUMBA_CACHE_DIR"]
+
+prange = numba.prange
+
+#: Exact kernels: geometry, adjustment.
+njit = numba.njit(cache=True, nogil=True, fastmath=False)
+#: Exact kernels parallelised with ``prange`` over independent rows.
+pjit = numba.njit(cache=True, nogil=True, fastmath=False, parallel=True)
+#: Kernels whose results are compared statistically (costs, aggregation).
+fastjit = numba.njit(cache=True, nogil=True, fastmath=True)
+#: Parallel variant of :data:`fastjit`.
+pfastjit = numba.njit(cache=True, nogil=True, fastmath=True, parallel=True)

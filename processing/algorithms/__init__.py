@@ -1,0 +1,18 @@
+"""All TruOrtho Processing algorithms: the provider registers ``ALGORITHMS``.
+
+Add a new algorithm by importing its class here and appending it to the list.
+"""
+
+from __future__ import annotations
+
+from .environment import EnvironmentAlgorithm
+from .exportorientation import ExportOrientationAlgorithm
+from .importgcps import ImportGcpsAlgorithm
+from .importorientation import ImportOrientationAlgorithm
+
+ALGORITHMS: list[type] = [
+    EnvironmentAlgorithm,
+    ImportOrientationAlgorithm,
+    ExportOrientationAlgorithm,
+    ImportGcpsAlgorithm,
+]

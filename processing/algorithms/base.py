@@ -1,0 +1,49 @@
+"""Shared behaviour of TruOrtho algorithms: names, groups and help from data."""
+
+from __future__ import annotations
+
+from qgis.core import QgsProcessingAlgorithm
+
+from ..help import help_html, parameter_help
+from ..i18n import tr
+
+GROUPS = {
+    "orientation": "Orientation",
+    "tools": "Tools",
+}
+
+
+class TruOrthoAlgorithm(QgsProcessingAlgorithm):
+    """Base class: subclasses set ``NAME``, ``DISPLAY_NAME`` and ``GROUP_ID``."""
+
+    NAME = ""
+    DISPLAY_NAME = ""
+    GROUP_ID = "tools"
+
+    def name(self) -> str:
+        return self.NAME
+
+    def displayName(self) -> str:  # noqa: N802 - QGIS API
+        return tr(self.DISPLAY_NAME)
+
+    def group(self) -> str:
+        return tr(GROUPS[self.GROUP_ID])
+
+    def groupId(self) -> str:  # noqa: N802 - QGIS API
+        return self.GROUP_ID
+
+    def shortHelpString(self) -> str:  # noqa: N802 - QGIS API
+        return help_html(self.NAME)
+
+    def createInstance(self):  # noqa: N802 - QGIS API
+        return type(self)()
+
+    def add(self, param, advanced: bool = False):
+        """Add a parameter with its help text from the help data."""
+        text = parameter_help(self.NAME, param.name())
+        if text and hasattr(param, "setHelp"):
+            param.setHelp(text)
+        if advanced:
+            param.setFlags(param.flags() | param.FlagAdvanced)
+        self.addParameter(param)
+        return param

@@ -1,0 +1,64 @@
+"""Bridges between QGIS Processing and the core's progress and error protocol.
+
+``FeedbackProgress`` adapts a ``QgsProcessingFeedback`` to the core's
+``Progress`` protocol (:mod:`truortho.core.progress`); :func:`core_errors`
+turns :class:`~truortho.core.errors.TruOrthoError` into
+``QgsProcessingException`` -- the one place where that happens.
+"""
+
+from __future__ import annotations
+
+import contextlib
+
+from qgis.core import QgsProcessingException
+
+from ..core.errors import CancelledError, TruOrthoError
+from .i18n import tr
+
+
+class FeedbackProgress:
+    """Core ``Progress`` backed by a ``QgsProcessingFeedback`` (or None)."""
+
+    def __init__(self, feedback) -> None:
+        self.feedback = feedback
+        self._last_message: str | None = None
+
+    def update(self, fraction: float, message: str | None = None) -> None:
+        if self.feedback is None:
+            return
+        f = min(max(float(fraction), 0.0), 1.0)
+        self.feedback.setProgress(100.0 * f)
+        if message and message != self._last_message:
+            self.feedback.pushInfo(message)
+            self._last_message = message
+
+    def cancelled(self) -> bool:
+        return bool(self.feedback is not None and self.feedback.isCanceled())
+
+
+class core_errors(contextlib.ContextDecorator):  # noqa: N801 - used like a function
+    """Context manager and decorator: ``TruOrthoError`` -> ``QgsProcessingException``.
+
+    ::
+
+        with core_errors():
+            result = core.something(..., progress=FeedbackProgress(feedback))
+
+        @core_errors()
+        def processAlgorithm(self, parameters, context, feedback): ...
+    """
+
+    def __enter__(self) -> core_errors:
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        if exc is None:
+            return False
+        if isinstance(exc, CancelledError):
+            detail = str(exc)
+            msg = tr("Cancelled by the user")
+            raise QgsProcessingException(f"{msg}: {detail}" if detail else msg) from exc
+        if isinstance(exc, TruOrthoError):
+            raise QgsProcessingException(str(exc)) from exc
+        return False
+

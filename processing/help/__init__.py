@@ -1,0 +1,94 @@
+"""Help texts of the algorithms, as data (keyed by algorithm name).
+
+Each entry: ``summary`` (one paragraph), ``parameters`` (name -> text) and
+optional ``notes``. Texts go through ``tr()`` when shown.
+"""
+
+from __future__ import annotations
+
+from html import escape
+
+from ..i18n import tr
+
+HELP: dict[str, dict] = {
+    "importorientation": {
+        "summary": (
+            "Imports the orientation of an image block (interior and exterior orientation of every "
+            "image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's "
+            "orientation JSON, and writes a layer of projection centres and a layer of image "
+            "footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; "
+            "see the README, 'Formats and conventions'."
+        ),
+        "parameters": {
+            "INPUT": (
+                "COLMAP text model (cameras.txt, images.txt or points3D.txt; the folder is used, with "
+                "an optional georef.json {\"crs\": ..., \"offset\": [E, N, H]}), Orthority exterior "
+                "CSV (filename, x, y, z, omega, phi, kappa[, camera]; degrees), OpenSfM/ODM "
+                "reconstruction.json, or a TruOrtho orientation JSON."
+            ),
+            "INTERIOR": "Orthority interior parameter file (YAML or JSON); required with a CSV input.",
+            "CRS": "CRS of the input coordinates when the file does not state it (CSV without .prj, "
+                   "COLMAP without georef.json); target CRS for OpenSfM's topocentric frame.",
+            "IMAGE_FOLDER": "Folder holding the images; every image of the block must be present there.",
+            "GCPS": "Optional ground control: point layer with 'name', 'role' (gcp|check), PointZ or a 'z' "
+                    "field, optional 'sigma_xy'/'sigma_z' in metres. Reprojected to the orientation's CRS.",
+            "OBSERVATIONS": "Image measurements of the GCPs: table with 'gcp', 'image', 'x', 'y' in pixels "
+                            "((0, 0) = centre of the top-left pixel).",
+            "FOOTPRINT_HEIGHT": "Height (in the CRS) of the plane the footprints are drawn on; default the "
+                                "median height of the sparse points, or of the GCPs, or 0.",
+            "OUTPUT": "The orientation JSON (TruOrtho format, version 1).",
+            "CAMERAS": "Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees).",
+            "FOOTPRINTS": "Image footprints on the horizontal plane at FOOTPRINT_HEIGHT.",
+        },
+    },
+    "exportorientation": {
+        "summary": (
+            "Exports a TruOrtho orientation JSON to a COLMAP text model (cameras.txt, images.txt, "
+            "points3D.txt and georef.json) or to Orthority frame-camera files (exterior.csv with a "
+            ".prj sidecar and interior.yaml)."
+        ),
+        "parameters": {
+            "INPUT": "A TruOrtho orientation JSON.",
+            "FORMAT": "colmap or opk (Orthority CSV + interior file).",
+            "OUTPUT": "Folder the files are written to (created if needed).",
+        },
+    },
+    "importgcps": {
+        "summary": (
+            "Reads an ODM/OpenSfM gcp_list.txt (first line EPSG code, PROJ string or 'WGS84 UTM nnX'; "
+            "then 'X Y Z px py image [name]') into a GCP point layer and an observation table, the "
+            "two inputs ground control takes everywhere in TruOrtho."
+        ),
+        "parameters": {
+            "INPUT": "The gcp_list.txt file.",
+            "CHECK_POINTS": "Comma-separated GCP names to mark as check points (role 'check').",
+            "SIGMA_XY": "Default planimetric standard deviation of the GCP coordinates, metres.",
+            "SIGMA_Z": "Default height standard deviation of the GCP coordinates, metres.",
+            "CRS": "Optional CRS to reproject the GCPs to (default: the file's CRS).",
+            "GCPS": "GCP point layer (PointZ): name, role, z, sigma_xy, sigma_z.",
+            "OBSERVATIONS": "Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the "
+                            "top-left pixel, as in gcp_list.txt).",
+        },
+    },
+}
+
+
+def help_html(name: str) -> str:
+    entry = HELP.get(name)
+    if not entry:
+        return ""
+    parts = [f"<p>{escape(tr(entry['summary']))}</p>"]
+    params = entry.get("parameters", {})
+    if params:
+        parts.append("<dl>")
+        for key, text in params.items():
+            parts.append(f"<dt><b>{escape(key)}</b></dt><dd>{escape(tr(text))}</dd>")
+        parts.append("</dl>")
+    if entry.get("notes"):
+        parts.append(f"<p>{escape(tr(entry['notes']))}</p>")
+    return "".join(parts)
+
+
+def parameter_help(name: str, parameter: str) -> str:
+    text = HELP.get(name, {}).get("parameters", {}).get(parameter, "")
+    return tr(text) if text else ""

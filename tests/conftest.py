@@ -1,0 +1,109 @@
+"""Shared test setup.
+
+Layout: ``tests/core/`` tests need only numpy & co. and run everywhere;
+``tests/qgis/`` tests (marked ``qgis``) need QGIS and are not collected when
+``qgis.core`` cannot be imported. There is deliberately no ``__init__.py`` in
+``tests/`` (the repository root is itself the ``truortho`` package) and tests
+run with ``--import-mode=importlib``.
+
+QGIS is started by pytest-qgis (``qgis_app``/``qgis_processing`` fixtures)
+when that plugin is installed (it is, in .venv); otherwise by the fallback here.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+import pytest
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+
+os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
+
+
+def _ensure_truortho_importable() -> None:
+    """Make ``import truortho`` work even outside the venv (whose .pth does it).
+
+    The repository root must never be on sys.path itself: its ``processing/``
+    would shadow QGIS's ``processing``. Link it as ``truortho`` in a temp dir.
+    """
+    spec = importlib.util.find_spec("truortho")
+    if spec is not None and spec.origin and Path(spec.origin).resolve().parent == REPO_ROOT:
+        return
+    link_dir = Path(tempfile.mkdtemp(prefix="truortho-path-"))
+    (link_dir / "truortho").symlink_to(REPO_ROOT, target_is_directory=True)
+    sys.path.insert(0, str(link_dir))
+
+
+_ensure_truortho_importable()
+
+try:
+    import qgis.core  # noqa: F401
+
+    HAVE_QGIS = True
+except ImportError:
+    HAVE_QGIS = False
+
+collect_ignore: list[str] = [] if HAVE_QGIS else ["qgis"]
+
+
+def pytest_report_header(config):
+    return f"truortho: {REPO_ROOT}; QGIS tests {'enabled' if HAVE_QGIS else 'NOT collected (no qgis.core)'}"
+
+
+def pytest_collection_modifyitems(config, items):
+    qgis_dir = REPO_ROOT / "tests" / "qgis"
+    for item in items:
+        if qgis_dir in Path(str(item.path)).parents and item.get_closest_marker("qgis") is None:
+            item.add_marker(pytest.mark.qgis)
+
+
+@pytest.fixture(scope="session")
+def qgis_processing_ready(request):
+    """A running QgsApplication with QGIS's Processing framework initialized."""
+    if not HAVE_QGIS:
+        pytest.skip("QGIS is not importable")
+    if request.config.pluginmanager.hasplugin("pytest_qgis"):
+        request.getfixturevalue("qgis_processing")
+        from qgis.core import QgsApplication
+
+        return QgsApplication.instance()
+
+    from qgis.core import QgsApplication
+
+    app = QgsApplication.instance()
+    if app is None:
+        app = QgsApplication([], False)
+        app.initQgis()
+        request.config._truortho_qgis_app = app  # keep a reference for the session
+    plugins = os.path.join(QgsApplication.pkgDataPath(), "python", "plugins")
+    if plugins not in sys.path:
+        sys.path.append(plugins)
+    from processing.core.Processing import Processing
+
+    Processing.initialize()
+    return app
+
+
+@pytest.fixture(scope="session")
+def truortho_plugin(qgis_processing_ready):
+    """The plugin started as QGIS starts it (classFactory + initProcessing)."""
+    import truortho
+
+    plugin = truortho.classFactory(None)
+    plugin.initProcessing()
+    yield plugin
+    plugin.unload()
+
+
+@pytest.fixture(scope="session")
+def truortho_provider(truortho_plugin):
+    from qgis.core import QgsApplication
+
+    provider = QgsApplication.processingRegistry().providerById("truortho")
+    assert provider is not None, "TruOrtho provider is not registered"
+    return provider

@@ -1,0 +1,1 @@
+"""QGIS desktop integration of TruOrtho (plugin entry object)."""
