@@ -37,6 +37,7 @@ import math
 import os
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath, PureWindowsPath
+from typing import NoReturn
 
 import numpy as np
 
@@ -225,8 +226,9 @@ class Orientation:
         if self.points is not None:
             p = self.points
             pts = SparsePoints(p.xyz + shift, p.rgb, p.error, p.obs_point, p.obs_image, p.obs_xy)
-        return Orientation(new, dict(self.cameras), images, pts, list(self.gcps), self.image_root,
-                           dict(self.metadata))
+        return Orientation(
+            new, dict(self.cameras), images, pts, list(self.gcps), self.image_root, dict(self.metadata)
+        )
 
     # --------------------------------------------------------------- JSON
     def to_dict(self, image_root: str | None = None) -> dict:
@@ -237,7 +239,8 @@ class Orientation:
             "offset": [float(v) for v in self.frame.offset],
             "image_root": image_root if image_root is not None else self.image_root,
             "cameras": {
-                cid: {k: v for k, v in cam.as_dict().items() if k != "id"} for cid, cam in self.cameras.items()
+                cid: {k: v for k, v in cam.as_dict().items() if k != "id"}
+                for cid, cam in self.cameras.items()
             },
             "images": [
                 {
@@ -259,7 +262,7 @@ class Orientation:
                 pd["error"] = p.error.tolist()
             pd["observations"] = [
                 [int(a), int(b), float(x), float(y)]
-                for a, b, (x, y) in zip(p.obs_point, p.obs_image, p.obs_xy, strict=False)
+                for a, b, (x, y) in zip(p.obs_point, p.obs_image, p.obs_xy, strict=True)
             ]
             d["points"] = pd
         if self.gcps:
@@ -269,7 +272,9 @@ class Orientation:
                     "role": g.role,
                     "xyz": [float(v) for v in g.xyz],
                     "sigma": None if g.sigma is None else [float(v) for v in g.sigma],
-                    "observations": [{"image": i, "x": float(x), "y": float(y)} for i, x, y in g.observations],
+                    "observations": [
+                        {"image": i, "x": float(x), "y": float(y)} for i, x, y in g.observations
+                    ],
                 }
                 for g in self.gcps
             ]
@@ -343,7 +348,9 @@ def check_relative_path(p: object, what: str) -> str:
         raise InputError(f"{what}: expected a non-empty relative path, got {p!r}")
     posix = PurePosixPath(p.replace("\\", "/"))
     if posix.is_absolute() or PureWindowsPath(p).drive or PureWindowsPath(p).is_absolute():
-        raise InputError(f"{what}: absolute paths are not allowed ({p!r}); give it relative to the image folder")
+        raise InputError(
+            f"{what}: absolute paths are not allowed ({p!r}); give it relative to the image folder"
+        )
     if any(part == ".." for part in posix.parts):
         raise InputError(f"{what}: '..' is not allowed in {p!r}; images must lie under the image folder")
     return str(posix)
@@ -356,11 +363,11 @@ class _Reader:
     def __init__(self, source: str) -> None:
         self.source = source
 
-    def fail(self, field_: str, msg: str):
+    def fail(self, field_: str, msg: str) -> NoReturn:
         raise FormatError(self.source, f"{field_}: {msg}")
 
     def num(self, v: object, field_: str) -> float:
-        if isinstance(v, bool) or not isinstance(v, (int, float)):
+        if isinstance(v, bool) or not isinstance(v, int | float):
             self.fail(field_, f"expected a number, got {type(v).__name__}")
         f = float(v)  # type: ignore[arg-type]
         if not math.isfinite(f) or abs(f) > 1e15:
@@ -410,7 +417,7 @@ def _from_dict(d: object, source: str, base_dir: str | None) -> Orientation:
     cameras: dict[str, Camera] = {}
     for cid, c in r.obj(d.get("cameras", {}), "cameras").items():
         c = r.obj(c, f"cameras.{cid}")
-        kw = {}
+        kw: dict[str, float] = {}
         for key in ("fx", "fy", "cx", "cy", "k1", "k2", "k3", "p1", "p2"):
             if key in c:
                 kw[key] = r.num(c[key], f"cameras.{cid}.{key}")
@@ -449,21 +456,30 @@ def _from_dict(d: object, source: str, base_dir: str | None) -> Orientation:
     points = None
     if d.get("points") is not None:
         p = r.obj(d["points"], "points")
-        xyz = np.array([r.vec(v, 3, f"points.xyz[{k}]") for k, v in enumerate(r.lst(p.get("xyz", []), "points.xyz"))])
+        xyz = np.array(
+            [r.vec(v, 3, f"points.xyz[{k}]") for k, v in enumerate(r.lst(p.get("xyz", []), "points.xyz"))]
+        )
         rgb = None
         if p.get("rgb") is not None:
-            rgb = [r.vec(v, 3, f"points.rgb[{k}]") for k, v in enumerate(r.lst(p["rgb"], "points.rgb"))]
+            rgb = np.array(
+                [r.vec(v, 3, f"points.rgb[{k}]") for k, v in enumerate(r.lst(p["rgb"], "points.rgb"))]
+            )
         err_ = None
         if p.get("error") is not None:
-            err_ = [r.num(v, f"points.error[{k}]") for k, v in enumerate(r.lst(p["error"], "points.error"))]
-        obs = [r.vec(v, 4, f"points.observations[{k}]") for k, v in
-               enumerate(r.lst(p.get("observations", []), "points.observations"))]
+            err_ = np.array(
+                [r.num(v, f"points.error[{k}]") for k, v in enumerate(r.lst(p["error"], "points.error"))]
+            )
+        obs = [
+            r.vec(v, 4, f"points.observations[{k}]")
+            for k, v in enumerate(r.lst(p.get("observations", []), "points.observations"))
+        ]
         oa = np.array(obs).reshape(-1, 4)
         if np.any(oa[:, :2] != np.round(oa[:, :2])):
             r.fail("points.observations", "point and image indices must be integers")
         try:
-            points = SparsePoints(xyz.reshape(-1, 3), rgb, err_, oa[:, 0].astype(np.int64),
-                                  oa[:, 1].astype(np.int64), oa[:, 2:])
+            points = SparsePoints(
+                xyz.reshape(-1, 3), rgb, err_, oa[:, 0].astype(np.int64), oa[:, 1].astype(np.int64), oa[:, 2:]
+            )
         except InputError as err:
             r.fail("points", str(err))
 
@@ -473,14 +489,18 @@ def _from_dict(d: object, source: str, base_dir: str | None) -> Orientation:
         name = r.text(g.get("name"), f"gcps[{i}].name")
         xyz = r.vec(g.get("xyz"), 3, f"gcps[{i}].xyz")
         sigma = None if g.get("sigma") is None else r.vec(g["sigma"], 3, f"gcps[{i}].sigma")
-        obs = []
+        gobs: list[tuple[str, float, float]] = []
         for k, o in enumerate(r.lst(g.get("observations", []), f"gcps[{i}].observations")):
             o = r.obj(o, f"gcps[{i}].observations[{k}]")
-            obs.append((r.text(o.get("image"), f"gcps[{i}].observations[{k}].image"),
-                        r.num(o.get("x"), f"gcps[{i}].observations[{k}].x"),
-                        r.num(o.get("y"), f"gcps[{i}].observations[{k}].y")))
+            gobs.append(
+                (
+                    r.text(o.get("image"), f"gcps[{i}].observations[{k}].image"),
+                    r.num(o.get("x"), f"gcps[{i}].observations[{k}].x"),
+                    r.num(o.get("y"), f"gcps[{i}].observations[{k}].y"),
+                )
+            )
         try:
-            gcps.append(GCP(name, xyz, g.get("role", "gcp"), sigma, obs))
+            gcps.append(GCP(name, xyz, g.get("role", "gcp"), sigma, gobs))
         except InputError as err:
             r.fail(f"gcps[{i}]", str(err))
 

@@ -51,14 +51,13 @@ class core_errors(contextlib.ContextDecorator):  # noqa: N801 - used like a func
     def __enter__(self) -> core_errors:
         return self
 
-    def __exit__(self, exc_type, exc, tb) -> bool:
+    def __exit__(self, exc_type, exc, tb) -> None:
         if exc is None:
-            return False
+            return
         if isinstance(exc, CancelledError):
             detail = str(exc)
             msg = tr("Cancelled by the user")
             raise QgsProcessingException(f"{msg}: {detail}" if detail else msg) from exc
         if isinstance(exc, TruOrthoError):
             raise QgsProcessingException(str(exc)) from exc
-        return False
 

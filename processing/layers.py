@@ -83,13 +83,27 @@ def camera_fields() -> QgsFields:
 def camera_features(orientation: Orientation, fields: QgsFields):
     """One PointZ feature per image at its projection centre (world CRS)."""
     centres = orientation.world_centers()
-    for im, c in zip(orientation.images, centres, strict=False):
+    for im, c in zip(orientation.images, centres, strict=True):
         cam = orientation.camera_of(im)
         o, p, k = matrix_to_opk(im.R, degrees=True)
         f = QgsFeature(fields)
         f.setGeometry(QgsGeometry(QgsPoint(float(c[0]), float(c[1]), float(c[2]))))
-        f.setAttributes([im.name, im.camera, im.path, float(c[0]), float(c[1]), float(c[2]),
-                         float(o), float(p), float(k), cam.fx, cam.width, cam.height])
+        f.setAttributes(
+            [
+                im.name,
+                im.camera,
+                im.path,
+                float(c[0]),
+                float(c[1]),
+                float(c[2]),
+                float(o),
+                float(p),
+                float(k),
+                cam.fx,
+                cam.width,
+                cam.height,
+            ]
+        )
         yield f
 
 
@@ -187,8 +201,13 @@ def _field_name(layer, name: str) -> str | None:
     return None
 
 
-def read_gcp_layer(layer, target_crs: QgsCoordinateReferenceSystem | None, transform_context,
-                   default_sigma_xy: float | None = None, default_sigma_z: float | None = None) -> list[GCP]:
+def read_gcp_layer(
+    layer,
+    target_crs: QgsCoordinateReferenceSystem | None,
+    transform_context,
+    default_sigma_xy: float | None = None,
+    default_sigma_z: float | None = None,
+) -> list[GCP]:
     """GCP records from a point layer, reprojected to ``target_crs`` when it differs.
 
     Raises ``QgsProcessingException`` naming the layer, the feature and the
@@ -205,7 +224,12 @@ def read_gcp_layer(layer, target_crs: QgsCoordinateReferenceSystem | None, trans
     sy_f = _field_name(layer, "sigma_y") or _field_name(layer, "sigma_xy")
     sz_f = _field_name(layer, "sigma_z")
     transform = None
-    if target_crs is not None and target_crs.isValid() and layer.crs().isValid() and layer.crs() != target_crs:
+    if (
+        target_crs is not None
+        and target_crs.isValid()
+        and layer.crs().isValid()
+        and layer.crs() != target_crs
+    ):
         transform = QgsCoordinateTransform(layer.crs(), target_crs, transform_context)
     gcps: list[GCP] = []
     seen: set[str] = set()
@@ -213,27 +237,36 @@ def read_gcp_layer(layer, target_crs: QgsCoordinateReferenceSystem | None, trans
         fid = feat.id()
         name = _value(feat, name_f)
         if name is None or str(name).strip() == "":
-            raise QgsProcessingException(tr("GCP layer {!r}: feature {} has no name").format(layer.name(), fid))
+            raise QgsProcessingException(
+                tr("GCP layer {!r}: feature {} has no name").format(layer.name(), fid)
+            )
         name = str(name).strip()
         if name in seen:
-            raise QgsProcessingException(tr("GCP layer {!r}: the name {!r} appears twice").format(layer.name(), name))
+            raise QgsProcessingException(
+                tr("GCP layer {!r}: the name {!r} appears twice").format(layer.name(), name)
+            )
         seen.add(name)
         geom = feat.geometry()
         if geom is None or geom.isEmpty():
-            raise QgsProcessingException(tr("GCP layer {!r}: GCP {!r} has no geometry").format(layer.name(), name))
+            raise QgsProcessingException(
+                tr("GCP layer {!r}: GCP {!r} has no geometry").format(layer.name(), name)
+            )
         pt = geom.constGet()
         if hasattr(pt, "x") and not hasattr(pt, "numGeometries"):
             x, y = pt.x(), pt.y()
             z = pt.z() if pt.is3D() else None
         else:
             raise QgsProcessingException(
-                tr("GCP layer {!r}: GCP {!r} is not a single point").format(layer.name(), name))
+                tr("GCP layer {!r}: GCP {!r} is not a single point").format(layer.name(), name)
+            )
         if z is None or (isinstance(z, float) and math.isnan(z)):
             z = _number(_value(feat, z_f), f"GCP {name!r} field z") if z_f else None
         if z is None:
             raise QgsProcessingException(
                 tr("GCP layer {!r}: GCP {!r} has no height: use PointZ geometries or a 'z' field").format(
-                    layer.name(), name))
+                    layer.name(), name
+                )
+            )
         if transform is not None:
             p = transform.transform(x, y)  # planimetric; heights are kept as given
             x, y = p.x(), p.y()
@@ -245,7 +278,9 @@ def read_gcp_layer(layer, target_crs: QgsCoordinateReferenceSystem | None, trans
         else:
             raise QgsProcessingException(
                 tr("GCP layer {!r}: GCP {!r} has role {!r}; expected 'gcp' or 'check'").format(
-                    layer.name(), name, role))
+                    layer.name(), name, role
+                )
+            )
         sx = _number(_value(feat, sx_f), f"GCP {name!r} sigma") if sx_f else None
         sy = _number(_value(feat, sy_f), f"GCP {name!r} sigma") if sy_f else None
         sz = _number(_value(feat, sz_f), f"GCP {name!r} sigma_z") if sz_f else None
@@ -277,13 +312,20 @@ def read_observation_table(layer, gcps: list[GCP], image_names: set[str] | None 
         image = str(_value(feat, names["image"]) or "").strip()
         if gname not in by_name:
             raise QgsProcessingException(
-                tr("Observation table {!r}, feature {}: unknown GCP {!r}").format(layer.name(), feat.id(), gname))
+                tr("Observation table {!r}, feature {}: unknown GCP {!r}").format(
+                    layer.name(), feat.id(), gname
+                )
+            )
         if image_names is not None and image not in image_names:
             raise QgsProcessingException(
-                tr("Observation table {!r}, feature {}: unknown image {!r}").format(layer.name(), feat.id(), image))
+                tr("Observation table {!r}, feature {}: unknown image {!r}").format(
+                    layer.name(), feat.id(), image
+                )
+            )
         x = _number(_value(feat, names["x"]), f"observation {feat.id()} x")
         y = _number(_value(feat, names["y"]), f"observation {feat.id()} y")
         if x is None or y is None:
             raise QgsProcessingException(
-                tr("Observation table {!r}, feature {}: x and y are required").format(layer.name(), feat.id()))
+                tr("Observation table {!r}, feature {}: x and y are required").format(layer.name(), feat.id())
+            )
         by_name[gname].observations.append((image, x, y))

@@ -7,7 +7,7 @@ float64 vector ``params = [fx, fy, cx, cy, k1, k2, k3, p1, p2]``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -48,7 +48,6 @@ class Camera:
     p1: float = 0.0
     p2: float = 0.0
     id: str = "camera"
-    extra: dict = field(default_factory=dict, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         self.validate()
@@ -56,7 +55,7 @@ class Camera:
     def validate(self) -> None:
         for name in ("width", "height"):
             v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v <= 0 or v > 10**6:
+            if isinstance(v, bool) or not isinstance(v, int | np.integer) or v <= 0 or v > 10**6:
                 raise InputError(f"camera {self.id!r}: {name} must be a positive integer, got {v!r}")
             setattr(self, name, int(v))
         for name in PARAM_NAMES:
@@ -69,7 +68,9 @@ class Camera:
                 raise InputError(f"camera {self.id!r}: {name} must be finite, got {v!r}")
             setattr(self, name, fv)
         if self.fx <= 0 or self.fy <= 0:
-            raise InputError(f"camera {self.id!r}: focal lengths must be positive (fx={self.fx}, fy={self.fy})")
+            raise InputError(
+                f"camera {self.id!r}: focal lengths must be positive (fx={self.fx}, fy={self.fy})"
+            )
 
     @property
     def params(self) -> np.ndarray:
@@ -81,7 +82,7 @@ class Camera:
         p = np.asarray(params, dtype=np.float64).reshape(-1)
         if p.shape != (9,):
             raise InputError(f"camera {id!r}: expected 9 parameters {PARAM_NAMES}, got {p.shape}")
-        return cls(width, height, *(float(x) for x in p), id=id)
+        return cls(width, height, **{n: float(v) for n, v in zip(PARAM_NAMES, p, strict=True)}, id=id)
 
     @property
     def K(self) -> np.ndarray:
@@ -98,7 +99,7 @@ class Camera:
         return any(getattr(self, n) != 0.0 for n in DISTORTION_NAMES)
 
     def as_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in fields(self) if f.name not in ("extra",)}
+        return {f.name: getattr(self, f.name) for f in fields(self)}
 
     def project_camera(self, xyz_cam) -> np.ndarray:
         """Pixels of points given in camera coordinates, shape (N, 3) -> (N, 2)."""
@@ -124,9 +125,18 @@ class Camera:
         w = max(1, int(round(self.width * factor)))
         h = max(1, int(round(self.height * factor)))
         return Camera(
-            w, h, self.fx * factor, self.fy * factor,
-            (self.cx + 0.5) * factor - 0.5, (self.cy + 0.5) * factor - 0.5,
-            self.k1, self.k2, self.k3, self.p1, self.p2, id=self.id,
+            w,
+            h,
+            self.fx * factor,
+            self.fy * factor,
+            (self.cx + 0.5) * factor - 0.5,
+            (self.cy + 0.5) * factor - 0.5,
+            self.k1,
+            self.k2,
+            self.k3,
+            self.p1,
+            self.p2,
+            id=self.id,
         )
 
 
@@ -310,5 +320,5 @@ def pixel_to_ray(uv, R, C, camera: Camera):
     xy = undistort_points(uv, camera)
     d_cam = np.column_stack([xy, np.ones(len(xy))])
     d = d_cam @ np.asarray(R, dtype=np.float64)  # R^T d_cam, row-wise
-    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    d = d / np.linalg.norm(d, axis=1, keepdims=True)
     return np.asarray(C, dtype=np.float64).reshape(3).copy(), d

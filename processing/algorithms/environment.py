@@ -112,14 +112,11 @@ class EnvironmentAlgorithm(QgsProcessingAlgorithm):
             feedback.reportError(tr("Not importable: {}").format(", ".join(missing)), False)
 
         if versions["rasterio"] is not None and versions["rasterio_gdal"] != versions["qgis_gdal"]:
-            raise QgsProcessingException(
-                tr("rasterio is linked to GDAL {} but QGIS uses GDAL {}: install Debian's python3-rasterio").format(
-                    versions["rasterio_gdal"], versions["qgis_gdal"]
-                )
-            )
+            message = tr("rasterio is linked to GDAL {} but QGIS uses GDAL {}: use Debian's python3-rasterio")
+            raise QgsProcessingException(message.format(versions["rasterio_gdal"], versions["qgis_gdal"]))
 
         path = self.parameterAsFileOutput(parameters, self.OUTPUT, context)
-        text = json.dumps(versions, indent=2, sort_keys=True)
+        text = json.dumps(versions, indent=2, sort_keys=True, ensure_ascii=False)
         if path:
             os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
             with open(path, "w", encoding="utf-8") as fh:

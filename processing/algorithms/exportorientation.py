@@ -28,9 +28,14 @@ class ExportOrientationAlgorithm(TruOrthoAlgorithm):
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(QgsProcessingParameterFile(self.INPUT, tr("Orientation (TruOrtho JSON)"), extension="json"))
-        self.add(QgsProcessingParameterEnum(
-            self.FORMAT, tr("Format"),
-            [tr("COLMAP text model"), tr("Orthority OPK CSV + interior file")], defaultValue=0))
+        self.add(
+            QgsProcessingParameterEnum(
+                self.FORMAT,
+                tr("Format"),
+                [tr("COLMAP text model"), tr("Orthority OPK CSV + interior file")],
+                defaultValue=0,
+            )
+        )
         self.add(QgsProcessingParameterFolderDestination(self.OUTPUT, tr("Output folder")))
         self.addOutput(QgsProcessingOutputMultipleLayers(self.FILES, tr("Files written")))
 

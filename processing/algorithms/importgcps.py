@@ -36,17 +36,40 @@ class ImportGcpsAlgorithm(TruOrthoAlgorithm):
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(QgsProcessingParameterFile(self.INPUT, tr("GCP list (ODM gcp_list.txt)")))
-        self.add(QgsProcessingParameterString(self.CHECK_POINTS, tr("Check point names (comma-separated)"),
-                                              optional=True))
-        self.add(QgsProcessingParameterNumber(self.SIGMA_XY, tr("Default sigma XY [m]"),
-                                              QgsProcessingParameterNumber.Double, 0.02, minValue=1e-6))
-        self.add(QgsProcessingParameterNumber(self.SIGMA_Z, tr("Default sigma Z [m]"),
-                                              QgsProcessingParameterNumber.Double, 0.03, minValue=1e-6))
+        self.add(
+            QgsProcessingParameterString(
+                self.CHECK_POINTS, tr("Check point names (comma-separated)"), optional=True
+            )
+        )
+        self.add(
+            QgsProcessingParameterNumber(
+                self.SIGMA_XY,
+                tr("Default sigma XY [m]"),
+                QgsProcessingParameterNumber.Double,
+                0.02,
+                minValue=1e-6,
+            )
+        )
+        self.add(
+            QgsProcessingParameterNumber(
+                self.SIGMA_Z,
+                tr("Default sigma Z [m]"),
+                QgsProcessingParameterNumber.Double,
+                0.03,
+                minValue=1e-6,
+            )
+        )
         self.add(QgsProcessingParameterCrs(self.CRS, tr("Reproject to CRS"), optional=True))
-        self.add(QgsProcessingParameterFeatureSink(self.GCPS, tr("Ground control points"),
-                                                   QgsProcessing.TypeVectorPoint))
-        self.add(QgsProcessingParameterFeatureSink(self.OBSERVATIONS, tr("GCP image measurements"),
-                                                   QgsProcessing.TypeVector))
+        self.add(
+            QgsProcessingParameterFeatureSink(
+                self.GCPS, tr("Ground control points"), QgsProcessing.TypeVectorPoint
+            )
+        )
+        self.add(
+            QgsProcessingParameterFeatureSink(
+                self.OBSERVATIONS, tr("GCP image measurements"), QgsProcessing.TypeVector
+            )
+        )
 
     @core_errors()
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 - QGIS API
@@ -63,12 +86,18 @@ class ImportGcpsAlgorithm(TruOrthoAlgorithm):
                 g.xyz[0], g.xyz[1] = p.x(), p.y()
             src = dst
         names = {g.name for g in gcps}
-        checks = [s.strip() for s in (self.parameterAsString(parameters, self.CHECK_POINTS, context) or "").split(",")
-                  if s.strip()]
+        checks = [
+            s.strip()
+            for s in (self.parameterAsString(parameters, self.CHECK_POINTS, context) or "").split(",")
+            if s.strip()
+        ]
         unknown = [c for c in checks if c not in names]
         if unknown:
-            raise QgsProcessingException(tr("CHECK_POINTS: unknown GCP name(s) {}; the file has {}").format(
-                ", ".join(unknown), ", ".join(sorted(names))))
+            raise QgsProcessingException(
+                tr("CHECK_POINTS: unknown GCP name(s) {}; the file has {}").format(
+                    ", ".join(unknown), ", ".join(sorted(names))
+                )
+            )
         for g in gcps:
             g.role = "check" if g.name in checks else "gcp"
         sxy = self.parameterAsDouble(parameters, self.SIGMA_XY, context)
@@ -81,15 +110,17 @@ class ImportGcpsAlgorithm(TruOrthoAlgorithm):
         for g in gcps:
             sink.addFeature(gcp_feature(g, fields, sxy, sz), QgsFeatureSink.FastInsert)
         ofields = observation_fields()
-        osink, obs_id = self.parameterAsSink(parameters, self.OBSERVATIONS, context, ofields,
-                                             QgsWkbTypes.NoGeometry)
+        osink, obs_id = self.parameterAsSink(
+            parameters, self.OBSERVATIONS, context, ofields, QgsWkbTypes.NoGeometry
+        )
         if osink is None:
             raise QgsProcessingException(self.invalidSinkError(parameters, self.OBSERVATIONS))
         n_obs = 0
         for f in observation_features(gcps, ofields):
             osink.addFeature(f, QgsFeatureSink.FastInsert)
             n_obs += 1
-        feedback.pushInfo(tr("{} GCPs ({} check points), {} image measurements").format(
-            len(gcps), len(checks), n_obs))
+        feedback.pushInfo(
+            tr("{} GCPs ({} check points), {} image measurements").format(len(gcps), len(checks), n_obs)
+        )
         feedback.setProgress(100)
         return {self.GCPS: gcps_id, self.OBSERVATIONS: obs_id}

@@ -57,24 +57,61 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
     FOOTPRINTS = "FOOTPRINTS"
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
-        self.add(QgsProcessingParameterFile(self.INPUT, tr("Orientation file (COLMAP, Orthority CSV, OpenSfM)")))
-        self.add(QgsProcessingParameterFile(self.INTERIOR, tr("Interior parameter file (Orthority)"),
-                                            optional=True))
-        self.add(QgsProcessingParameterCrs(self.CRS, tr("CRS of the input (when the file has none)"),
-                                           optional=True))
-        self.add(QgsProcessingParameterFile(self.IMAGE_FOLDER, tr("Image folder"),
-                                            behavior=QgsProcessingParameterFile.Folder, optional=True))
-        self.add(QgsProcessingParameterVectorLayer(self.GCPS, tr("Ground control points"),
-                                                   [QgsProcessing.TypeVectorPoint], optional=True))
-        self.add(QgsProcessingParameterVectorLayer(self.OBSERVATIONS, tr("GCP image measurements (table)"),
-                                                   [QgsProcessing.TypeVector], optional=True))
-        self.add(QgsProcessingParameterNumber(self.FOOTPRINT_HEIGHT, tr("Footprint height"),
-                                              QgsProcessingParameterNumber.Double, optional=True))
-        self.add(QgsProcessingParameterFileDestination(self.OUTPUT, tr("Orientation (JSON)"),
-                                                       tr("JSON files (*.json)")))
-        self.add(QgsProcessingParameterFeatureSink(self.CAMERAS, tr("Cameras"), QgsProcessing.TypeVectorPoint))
-        self.add(QgsProcessingParameterFeatureSink(self.FOOTPRINTS, tr("Footprints"),
-                                                   QgsProcessing.TypeVectorPolygon, optional=True))
+        self.add(
+            QgsProcessingParameterFile(self.INPUT, tr("Orientation file (COLMAP, Orthority CSV, OpenSfM)"))
+        )
+        self.add(
+            QgsProcessingParameterFile(
+                self.INTERIOR, tr("Interior parameter file (Orthority)"), optional=True
+            )
+        )
+        self.add(
+            QgsProcessingParameterCrs(
+                self.CRS, tr("CRS of the input (when the file has none)"), optional=True
+            )
+        )
+        self.add(
+            QgsProcessingParameterFile(
+                self.IMAGE_FOLDER,
+                tr("Image folder"),
+                behavior=QgsProcessingParameterFile.Folder,
+                optional=True,
+            )
+        )
+        self.add(
+            QgsProcessingParameterVectorLayer(
+                self.GCPS, tr("Ground control points"), [QgsProcessing.TypeVectorPoint], optional=True
+            )
+        )
+        self.add(
+            QgsProcessingParameterVectorLayer(
+                self.OBSERVATIONS,
+                tr("GCP image measurements (table)"),
+                [QgsProcessing.TypeVector],
+                optional=True,
+            )
+        )
+        self.add(
+            QgsProcessingParameterNumber(
+                self.FOOTPRINT_HEIGHT,
+                tr("Footprint height"),
+                QgsProcessingParameterNumber.Double,
+                optional=True,
+            )
+        )
+        self.add(
+            QgsProcessingParameterFileDestination(
+                self.OUTPUT, tr("Orientation (JSON)"), tr("JSON files (*.json)")
+            )
+        )
+        self.add(
+            QgsProcessingParameterFeatureSink(self.CAMERAS, tr("Cameras"), QgsProcessing.TypeVectorPoint)
+        )
+        self.add(
+            QgsProcessingParameterFeatureSink(
+                self.FOOTPRINTS, tr("Footprints"), QgsProcessing.TypeVectorPolygon, optional=True
+            )
+        )
 
     @core_errors()
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 - QGIS API
@@ -87,14 +124,22 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
         interior = self.parameterAsFile(parameters, self.INTERIOR, context) or None
         crs_param = self.parameterAsCrs(parameters, self.CRS, context)
         orientation = read_orientation(path, interior, crs_text(crs_param))
-        feedback.pushInfo(tr("Read {} images, {} cameras, {} sparse points").format(
-            len(orientation.images), len(orientation.cameras),
-            0 if orientation.points is None else len(orientation.points)))
+        feedback.pushInfo(
+            tr("Read {} images, {} cameras, {} sparse points").format(
+                len(orientation.images),
+                len(orientation.cameras),
+                0 if orientation.points is None else len(orientation.points),
+            )
+        )
         if not orientation.images:
             raise QgsProcessingException(tr("{}: the orientation contains no images").format(path))
         if orientation.crs is None:
-            feedback.pushWarning(tr("The orientation has no CRS: it stays in its arbitrary (local) frame. "
-                                    "Give CRS (or a georef.json) to georeference it."))
+            feedback.pushWarning(
+                tr(
+                    "The orientation has no CRS: it stays in its arbitrary (local) frame. "
+                    "Give CRS (or a georef.json) to georeference it."
+                )
+            )
         steps[0].update(1.0)
 
         folder = self.parameterAsFile(parameters, self.IMAGE_FOLDER, context)
@@ -110,20 +155,25 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
         if gcp_layer is not None:
             if orientation.crs is None and gcp_layer.crs().isValid():
                 raise QgsProcessingException(
-                    tr("GCPs need a georeferenced orientation: give CRS for the input"))
+                    tr("GCPs need a georeferenced orientation: give CRS for the input")
+                )
             gcps = read_gcp_layer(gcp_layer, target, context.transformContext())
             read_observation_table(obs_layer, gcps, {im.name for im in orientation.images})
             orientation.gcps = gcps
-            feedback.pushInfo(tr("{} GCPs with {} image measurements").format(
-                len(gcps), sum(len(g.observations) for g in gcps)))
+            feedback.pushInfo(
+                tr("{} GCPs with {} image measurements").format(
+                    len(gcps), sum(len(g.observations) for g in gcps)
+                )
+            )
         steps[1].update(1.0)
 
         out = self.parameterAsFileOutput(parameters, self.OUTPUT, context)
         orientation.save(out)
 
         fields = camera_fields()
-        sink, cameras_id = self.parameterAsSink(parameters, self.CAMERAS, context, fields,
-                                                QgsWkbTypes.PointZ, target)
+        sink, cameras_id = self.parameterAsSink(
+            parameters, self.CAMERAS, context, fields, QgsWkbTypes.PointZ, target
+        )
         if sink is None:
             raise QgsProcessingException(self.invalidSinkError(parameters, self.CAMERAS))
         n = len(orientation.images)
@@ -132,8 +182,9 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
             steps[2].update((i + 1) / n)
 
         results = {self.OUTPUT: out, self.CAMERAS: cameras_id}
-        fsink, foot_id = self.parameterAsSink(parameters, self.FOOTPRINTS, context, footprint_fields(),
-                                              QgsWkbTypes.PolygonZ, target)
+        fsink, foot_id = self.parameterAsSink(
+            parameters, self.FOOTPRINTS, context, footprint_fields(), QgsWkbTypes.PolygonZ, target
+        )
         if fsink is not None:
             height = self.parameterAsDouble(parameters, self.FOOTPRINT_HEIGHT, context)
             if parameters.get(self.FOOTPRINT_HEIGHT) is None:
@@ -145,11 +196,15 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
                     break
                 ring = footprint_on_plane(im.R, im.C, orientation.camera_of(im), z_local)
                 if ring is None:
-                    feedback.pushWarning(tr("Image {} does not see the plane at height {}").format(im.name, height))
+                    feedback.pushWarning(
+                        tr("Image {} does not see the plane at height {}").format(im.name, height)
+                    )
                     continue
                 ring_world = ring + orientation.offset[:2]
-                fsink.addFeature(footprint_feature(im.name, im.camera, ring_world, height, ffields),
-                                 QgsFeatureSink.FastInsert)
+                fsink.addFeature(
+                    footprint_feature(im.name, im.camera, ring_world, height, ffields),
+                    QgsFeatureSink.FastInsert,
+                )
                 steps[3].update((i + 1) / n)
             results[self.FOOTPRINTS] = foot_id
         return results

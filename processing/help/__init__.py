@@ -22,22 +22,23 @@ HELP: dict[str, dict] = {
         "parameters": {
             "INPUT": (
                 "COLMAP text model (cameras.txt, images.txt or points3D.txt; the folder is used, with "
-                "an optional georef.json {\"crs\": ..., \"offset\": [E, N, H]}), Orthority exterior "
+                'an optional georef.json {"crs": ..., "offset": [E, N, H]}), Orthority exterior '
                 "CSV (filename, x, y, z, omega, phi, kappa[, camera]; degrees), OpenSfM/ODM "
                 "reconstruction.json, or a TruOrtho orientation JSON."
             ),
             "INTERIOR": "Orthority interior parameter file (YAML or JSON); required with a CSV input.",
             "CRS": "CRS of the input coordinates when the file does not state it (CSV without .prj, "
-                   "COLMAP without georef.json); target CRS for OpenSfM's topocentric frame.",
+            "COLMAP without georef.json); target CRS for OpenSfM's topocentric frame.",
             "IMAGE_FOLDER": "Folder holding the images; every image of the block must be present there.",
             "GCPS": "Optional ground control: point layer with 'name', 'role' (gcp|check), PointZ or a 'z' "
-                    "field, optional 'sigma_xy'/'sigma_z' in metres. Reprojected to the orientation's CRS.",
+            "field, optional 'sigma_xy'/'sigma_z' in metres. Reprojected to the orientation's CRS.",
             "OBSERVATIONS": "Image measurements of the GCPs: table with 'gcp', 'image', 'x', 'y' in pixels "
-                            "((0, 0) = centre of the top-left pixel).",
+            "((0, 0) = centre of the top-left pixel).",
             "FOOTPRINT_HEIGHT": "Height (in the CRS) of the plane the footprints are drawn on; default the "
-                                "median height of the sparse points, or of the GCPs, or 0.",
+            "median height of the sparse points, or of the GCPs, or 0.",
             "OUTPUT": "The orientation JSON (TruOrtho format, version 1).",
-            "CAMERAS": "Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees).",
+            "CAMERAS": "Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa "
+            "(degrees).",
             "FOOTPRINTS": "Image footprints on the horizontal plane at FOOTPRINT_HEIGHT.",
         },
     },
@@ -67,7 +68,7 @@ HELP: dict[str, dict] = {
             "CRS": "Optional CRS to reproject the GCPs to (default: the file's CRS).",
             "GCPS": "GCP point layer (PointZ): name, role, z, sigma_xy, sigma_z.",
             "OBSERVATIONS": "Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the "
-                            "top-left pixel, as in gcp_list.txt).",
+            "top-left pixel, as in gcp_list.txt).",
         },
     },
 }

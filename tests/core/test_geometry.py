@@ -67,7 +67,11 @@ def test_undistort_inverts_distort(cam):
     np.testing.assert_allclose(back, xy, atol=1e-10)
     # against OpenCV's iterative undistortion (less exact: 5 iterations by default)
     ref = cv2.undistortPointsIter(
-        uv.reshape(-1, 1, 2), cam.K, cam.dist_coeffs, None, None,
+        uv.reshape(-1, 1, 2),
+        cam.K,
+        cam.dist_coeffs,
+        None,
+        None,
         (cv2.TERM_CRITERIA_COUNT | cv2.TERM_CRITERIA_EPS, 50, 1e-12),
     ).reshape(-1, 2)
     np.testing.assert_allclose(back, ref, atol=1e-7)
