@@ -1,0 +1,1 @@
+"""Structure from motion: features, matching, tracks, reconstruction and bundle adjustment."""
