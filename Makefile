@@ -20,16 +20,18 @@ lint: setup
 	$(ENV) $(PY) -m ruff check .
 	$(ENV) $(PY) -m mypy
 
+# -P: never put the current directory (the repo root) on sys.path, or our
+# processing/ would shadow QGIS's `processing`.
 # Extra pytest arguments: make pytest PYTEST_ARGS="-k provider -x"
 pytest: setup
-	$(ENV) QT_QPA_PLATFORM=offscreen $(PY) -m pytest --import-mode=importlib -p no:cacheprovider $(PYTEST_ARGS)
+	$(ENV) QT_QPA_PLATFORM=offscreen $(PY) -P -m pytest --import-mode=importlib -p no:cacheprovider $(PYTEST_ARGS)
 
 demo: setup
 	bash scripts/demo.sh
 
 bench: setup
 	@if $(PY) -c 'import importlib.util as u, sys; sys.exit(u.find_spec("truortho.bench") is None)' 2>/dev/null; then \
-		$(ENV) $(PY) -m truortho.bench; \
+		$(ENV) $(PY) -P -m truortho.bench; \
 	else \
 		echo "bench: truortho.bench does not exist yet"; \
 	fi

@@ -21,9 +21,7 @@ import os
 
 
 def _cache_dir() -> str:
-    base = os.environ.get("TRUORTHO_CACHE_DIR") or os.path.join(
-        os.path.expanduser("~"), ".cache", "truortho"
-    )
+    base = os.environ.get("TRUORTHO_CACHE_DIR") or os.path.join(os.path.expanduser("~"), ".cache", "truortho")
     return os.path.join(base, "numba")
 
 

@@ -149,7 +149,7 @@ def test_gcps_attach_to_orientation(truortho_provider, tmp_path):
     res = run(
         "truortho:importorientation",
         {
-            "INPUT": str(tmp_path / "m"),
+            "INPUT": str(tmp_path / "m" / "images.txt"),
             "GCPS": g["GCPS"],
             "OBSERVATIONS": obs,
             "OUTPUT": str(tmp_path / "o.json"),
@@ -198,7 +198,7 @@ def test_missing_image_is_named(truortho_provider, tmp_path):
         run(
             "truortho:importorientation",
             {
-                "INPUT": str(tmp_path / "m"),
+                "INPUT": str(tmp_path / "m" / "images.txt"),
                 "IMAGE_FOLDER": str(tmp_path / "imgs"),
                 "OUTPUT": str(tmp_path / "x.json"),
                 "CAMERAS": "memory:",
@@ -219,7 +219,7 @@ def test_unknown_camera_model_names_file_and_line(truortho_provider, tmp_path):
     with pytest.raises(QgsProcessingException, match=r"cameras.txt.*line \d+.*THIN_PRISM_FISHEYE"):
         run(
             "truortho:importorientation",
-            {"INPUT": str(tmp_path / "m"), "OUTPUT": str(tmp_path / "x.json"), "CAMERAS": "memory:"},
+            {"INPUT": str(tmp_path / "m" / "images.txt"), "OUTPUT": str(tmp_path / "x.json"), "CAMERAS": "memory:"},
         )
 
 
@@ -238,7 +238,7 @@ def test_gcp_layer_without_name_field(truortho_provider, tmp_path):
         run(
             "truortho:importorientation",
             {
-                "INPUT": str(tmp_path / "m"),
+                "INPUT": str(tmp_path / "m" / "images.txt"),
                 "GCPS": layer,
                 "OUTPUT": str(tmp_path / "x.json"),
                 "CAMERAS": "memory:",
@@ -282,7 +282,7 @@ def test_json_is_valid_after_import(truortho_provider, tmp_path):
     write_colmap(block(), tmp_path / "m")
     res = run(
         "truortho:importorientation",
-        {"INPUT": str(tmp_path / "m"), "OUTPUT": str(tmp_path / "o.json"), "CAMERAS": "memory:"},
+        {"INPUT": str(tmp_path / "m" / "images.txt"), "OUTPUT": str(tmp_path / "o.json"), "CAMERAS": "memory:"},
     )
     d = json.loads(Path(res["OUTPUT"]).read_text())
     assert d["format"] == "truortho-orientation" and d["version"] == 1
