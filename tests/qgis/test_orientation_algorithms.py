@@ -219,7 +219,11 @@ def test_unknown_camera_model_names_file_and_line(truortho_provider, tmp_path):
     with pytest.raises(QgsProcessingException, match=r"cameras.txt.*line \d+.*THIN_PRISM_FISHEYE"):
         run(
             "truortho:importorientation",
-            {"INPUT": str(tmp_path / "m" / "images.txt"), "OUTPUT": str(tmp_path / "x.json"), "CAMERAS": "memory:"},
+            {
+                "INPUT": str(tmp_path / "m" / "images.txt"),
+                "OUTPUT": str(tmp_path / "x.json"),
+                "CAMERAS": "memory:",
+            },
         )
 
 
@@ -282,7 +286,11 @@ def test_json_is_valid_after_import(truortho_provider, tmp_path):
     write_colmap(block(), tmp_path / "m")
     res = run(
         "truortho:importorientation",
-        {"INPUT": str(tmp_path / "m" / "images.txt"), "OUTPUT": str(tmp_path / "o.json"), "CAMERAS": "memory:"},
+        {
+            "INPUT": str(tmp_path / "m" / "images.txt"),
+            "OUTPUT": str(tmp_path / "o.json"),
+            "CAMERAS": "memory:",
+        },
     )
     d = json.loads(Path(res["OUTPUT"]).read_text())
     assert d["format"] == "truortho-orientation" and d["version"] == 1
