@@ -1,0 +1,74 @@
+"""Incremental reconstruction on synthetic tracks with known geometry."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from truortho.core.errors import CancelledError, InputError
+from truortho.core.geometry import Camera, opk_to_matrix, project_points
+from truortho.core.progress import CallbackProgress
+from truortho.core.sfm.incremental import IncrementalConfig, reconstruct
+from truortho.core.sfm.similarity import estimate_similarity
+
+
+def synthetic_tracks(seed=0, n_points=1500, noise=0.5, strips=3, per_strip=6):
+    rng = np.random.default_rng(seed)
+    cam = Camera(1200, 800, 1000.0, 1000.0, 601.3, 398.2, -0.06, 0.015, 0.0, 3e-4, -2e-4)
+    Rs, Cs = [], []
+    for s in range(strips):
+        for k in range(per_strip):
+            kappa = 0.0 if s % 2 == 0 else 180.0
+            Rs.append(opk_to_matrix(*rng.normal(0, 2, 2), kappa + rng.normal(0, 2), degrees=True))
+            Cs.append([k * 25.0 + rng.normal(0, 1), s * 45.0 + rng.normal(0, 1), 120.0 + rng.normal(0, 2)])
+    Rs, Cs = np.array(Rs), np.array(Cs)
+    X = np.column_stack(
+        [rng.uniform(-40, 165, n_points), rng.uniform(-35, 125, n_points), rng.uniform(0, 15, n_points)]
+    )
+    tr, im, xy = [], [], []
+    for i in range(len(Rs)):
+        uv = project_points(X, Rs[i], Cs[i], cam)
+        inside = (uv[:, 0] > 0) & (uv[:, 0] < cam.width - 1) & (uv[:, 1] > 0) & (uv[:, 1] < cam.height - 1)
+        idx = np.flatnonzero(inside)
+        tr.append(idx)
+        im.append(np.full(len(idx), i))
+        xy.append(uv[idx] + rng.normal(0, noise, (len(idx), 2)))
+    tr, im, xy = np.concatenate(tr), np.concatenate(im), np.concatenate(xy)
+    return cam, Rs, Cs, X, tr, im, xy
+
+
+def test_reconstructs_block_with_self_calibration():
+    cam, Rs, Cs, X, tr, im, xy = synthetic_tracks()
+    # prior: focal 8 % off, no distortion known
+    prior = Camera(cam.width, cam.height, 1080.0, 1080.0, 599.5, 399.5)
+    rec = reconstruct(tr, im, xy, np.zeros(len(Rs), int), [prior])
+    assert rec.registered.all(), rec.stats
+    sim = estimate_similarity(rec.centers, Cs)
+    err = np.linalg.norm(sim.apply(rec.centers) - Cs, axis=1)
+    assert np.sqrt(np.mean(err**2)) < 0.1, err  # metres, at 120 m height with 0.5 px noise
+    assert abs(rec.intrinsics[0, 0] - cam.fx) < 5.0
+    assert abs(rec.intrinsics[0, 4] - cam.k1) < 0.01
+    assert rec.stats["final_bundle"]["rms_px"] < 0.8
+    assert rec.point_ok.sum() > 0.9 * len(X)
+
+
+def test_cancel_and_bad_input():
+    cam, Rs, Cs, X, tr, im, xy = synthetic_tracks(n_points=300, strips=1, per_strip=4)
+    with pytest.raises(CancelledError):
+        reconstruct(tr, im, xy, np.zeros(4, int), [cam], progress=CallbackProgress(is_cancelled=lambda: True))
+    with pytest.raises(InputError, match="two images"):
+        reconstruct(tr, im, xy, np.zeros(1, int), [cam])
+    with pytest.raises(InputError, match="refine_intrinsics"):
+        reconstruct(tr, im, xy, np.zeros(4, int), [cam], IncrementalConfig(refine_intrinsics=("zoom",)))
+
+
+def test_images_without_overlap_stay_unregistered():
+    cam, Rs, Cs, X, tr, im, xy = synthetic_tracks(n_points=600, strips=1, per_strip=5)
+    # an extra image whose observations are of tracks nobody else sees
+    extra_tracks = tr.max() + 1 + np.arange(50)
+    rng = np.random.default_rng(1)
+    tr = np.concatenate([tr, extra_tracks])
+    im = np.concatenate([im, np.full(50, 5)])
+    xy = np.concatenate([xy, rng.uniform(0, 800, (50, 2))])
+    rec = reconstruct(tr, im, xy, np.zeros(6, int), [cam])
+    assert rec.registered[:5].all() and not rec.registered[5]
