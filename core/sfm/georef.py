@@ -1,0 +1,342 @@
+"""Datum definition: ground control (GCPs), check points and GNSS camera priors.
+
+From an arbitrarily scaled and placed reconstruction to the CRS:
+
+1. **Approximate datum**: control points (role ``gcp``) with at least two
+   observations in registered images are triangulated in the
+   reconstruction's frame; a 7-parameter similarity to their surveyed
+   coordinates (local frame) moves cameras and points. Without usable
+   control, EXIF GNSS camera positions play that part.
+2. **Adjustment**: the block is adjusted again with the control points as
+   extra points that carry both their image observations and a weighted
+   prior on their coordinates (standard deviations from the GCP layer or
+   defaults); GNSS centres enter as weighted priors when there is no control.
+3. **Check points** never enter the adjustment: they are triangulated from
+   the adjusted cameras and compared with their surveyed coordinates
+   (residual per point, RMSE per axis and in 3D).
+
+Plan-only control (heights unknown, e.g. all 0 in the file) is expressed by
+a large ``sigma_z``: the similarity then still uses the given heights (a
+tilt-free, horizontal datum at the given height), and the vertical check
+statistics say nothing about true heights.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import GeometryError, InputError
+from ..geometry.camera import Camera, undistort_points
+from ..orientation import GCP
+from ..progress import Progress
+from .bundle import BundleConfig, BundleProblem, bundle_adjust
+from .similarity import estimate_similarity
+from .triangulation import triangulate_tracks
+
+
+@dataclass
+class GeorefConfig:
+    """Default accuracies (metres, pixels) and adjustment options."""
+
+    gcp_sigma_xy: float = 0.02
+    gcp_sigma_z: float = 0.03
+    gcp_obs_sigma_px: float = 1.0
+    gps_sigma_xy: float = 3.0
+    gps_sigma_z: float = 5.0
+    refine_intrinsics: tuple[str, ...] = ("f", "cx", "cy", "k1", "k2", "p1", "p2")
+    max_iterations: int = 50
+    loss_scale_px: float = 2.0
+
+
+@dataclass
+class Block:
+    """A reconstructed block in a frame (local or arbitrary) ready for adjustment."""
+
+    image_names: list[str]
+    cameras: list[Camera]
+    image_camera: np.ndarray
+    rotations: np.ndarray
+    centers: np.ndarray
+    points: np.ndarray
+    obs_image: np.ndarray
+    obs_point: np.ndarray
+    obs_xy: np.ndarray
+
+    @property
+    def intrinsics(self) -> np.ndarray:
+        return np.array([c.params for c in self.cameras])
+
+    def transform(self, sim) -> None:
+        self.rotations = self.rotations @ sim.R.T
+        self.centers = sim.apply(self.centers)
+        self.points = sim.apply(self.points)
+
+
+@dataclass
+class GeorefResult:
+    method: str
+    gcp_table: list[dict] = field(default_factory=list)
+    check_table: list[dict] = field(default_factory=list)
+    check_rmse: dict = field(default_factory=dict)
+    gcp_rmse: dict = field(default_factory=dict)
+    bundle: object = None
+    warnings: list[str] = field(default_factory=list)
+    gcp_points: np.ndarray | None = None
+
+
+def _gcp_tracks(block: Block, gcps: list[GCP]):
+    """Observations of every GCP on images of the block: CSR arrays + names of unknown images."""
+    index = {n: i for i, n in enumerate(block.image_names)}
+    offs, img, xy, unknown = [0], [], [], []
+    for g in gcps:
+        for name, x, y in g.observations:
+            if name in index:
+                img.append(index[name])
+                xy.append((x, y))
+            else:
+                unknown.append((g.name, name))
+        offs.append(len(img))
+    return (
+        np.array(offs),
+        np.array(img, dtype=np.int64),
+        np.array(xy, dtype=np.float64).reshape(-1, 2),
+        unknown,
+    )
+
+
+def triangulate_gcps(block: Block, gcps: list[GCP]):
+    """Triangulate GCPs from their image measurements with the block's cameras.
+
+    Returns (xyz (G, 3) in the block's frame, NaN where fewer than two views; n_views (G,)).
+    """
+    offs, img, xy, _ = _gcp_tracks(block, gcps)
+    xn = np.empty_like(xy)
+    for k in range(len(img)):
+        cam = block.cameras[block.image_camera[img[k]]]
+        xn[k] = undistort_points(xy[k : k + 1], cam)[0]
+    focal = np.array([block.cameras[c].fx for c in block.image_camera])
+    res = triangulate_tracks(offs, img, xn, block.rotations, block.centers, focal)
+    n_views = np.diff(offs)
+    xyz = res.xyz.copy()
+    xyz[~res.ok | (n_views < 2)] = np.nan
+    return xyz, n_views, res.max_error
+
+
+def _rmse(d: np.ndarray) -> dict:
+    if len(d) == 0:
+        return {}
+    return {
+        "n": int(len(d)),
+        "x": float(np.sqrt(np.mean(d[:, 0] ** 2))),
+        "y": float(np.sqrt(np.mean(d[:, 1] ** 2))),
+        "z": float(np.sqrt(np.mean(d[:, 2] ** 2))),
+        "xy": float(np.sqrt(np.mean(d[:, 0] ** 2 + d[:, 1] ** 2))),
+        "3d": float(np.sqrt(np.mean(np.sum(d**2, axis=1)))),
+    }
+
+
+def georeference(
+    block: Block,
+    gcps: list[GCP],
+    offset: np.ndarray,
+    gps_centers: np.ndarray | None = None,
+    config: GeorefConfig | None = None,
+    progress: Progress | None = None,
+) -> GeorefResult:
+    """Move ``block`` (in place) into the local frame ``world - offset`` and adjust it.
+
+    Parameters
+    ----------
+    block : Block
+        Reconstruction in an arbitrary frame; updated in place.
+    gcps : list of GCP
+        Ground control and check points, world coordinates.
+    offset : (3,) float64
+        Local frame offset.
+    gps_centers : (n_img, 3) float64, optional
+        GNSS camera positions in the local frame (NaN rows where unknown).
+    """
+    cfg = config or GeorefConfig()
+    result = GeorefResult(method="none")
+    control = [g for g in gcps if g.role == "gcp"]
+    checks = [g for g in gcps if g.role == "check"]
+    _, _, _, unknown = _gcp_tracks(block, gcps)
+    for gname, iname in unknown:
+        result.warnings.append(
+            f"GCP {gname}: observation on image {iname!r}, which is not oriented or not in the block"
+        )
+
+    ctrl_xyz, ctrl_views, _ = (
+        triangulate_gcps(block, control) if control else (np.zeros((0, 3)), np.zeros(0), None)
+    )
+    usable = np.isfinite(ctrl_xyz[:, 0]) if len(control) else np.zeros(0, bool)
+    for g, ok, nv in zip(control, usable, ctrl_views, strict=True):
+        if not ok:
+            result.warnings.append(
+                f"GCP {g.name}: {int(nv)} observation(s) on oriented images; at least 2 are needed, not used"
+            )
+    target = np.array([g.xyz for g in control]).reshape(-1, 3) - offset
+    sim = None
+    if usable.sum() >= 3:
+        try:
+            sim = estimate_similarity(ctrl_xyz[usable], target[usable])
+            result.method = "gcp"
+        except GeometryError as err:
+            result.warnings.append(f"control points unusable for the datum: {err}")
+    if sim is None and gps_centers is not None:
+        ok = np.all(np.isfinite(gps_centers), axis=1)
+        if ok.sum() >= 3:
+            try:
+                sim = estimate_similarity(block.centers[ok], gps_centers[ok])
+                result.method = "gps"
+            except GeometryError as err:
+                result.warnings.append(f"GNSS positions unusable for the datum: {err}")
+    if sim is None:
+        if gcps:
+            result.warnings.append(
+                "fewer than 3 usable control points: the block stays in an arbitrary frame"
+            )
+        return result
+    block.transform(sim)
+
+    # adjustment with control points as prior-weighted points
+    n_tie = len(block.points)
+    pts = [block.points]
+    obs_img, obs_pt, obs_xy = [block.obs_image], [block.obs_point], [block.obs_xy]
+    sig = [np.ones(len(block.obs_image))]
+    prior_idx, prior_xyz, prior_sig = [], [], []
+    if result.method == "gcp":
+        ctrl_local = sim.apply(ctrl_xyz[usable])
+        index = {n: i for i, n in enumerate(block.image_names)}
+        k = 0
+        for g, ok in zip(control, usable, strict=True):
+            if not ok:
+                continue
+            pid = n_tie + k
+            pts.append(ctrl_local[k : k + 1])
+            for name, x, y in g.observations:
+                if name in index:
+                    obs_img.append(np.array([index[name]]))
+                    obs_pt.append(np.array([pid]))
+                    obs_xy.append(np.array([[x, y]]))
+                    sig.append(np.array([cfg.gcp_obs_sigma_px]))
+            s = (
+                g.sigma
+                if g.sigma is not None
+                else np.array([cfg.gcp_sigma_xy, cfg.gcp_sigma_xy, cfg.gcp_sigma_z])
+            )
+            prior_idx.append(pid)
+            prior_xyz.append(g.xyz - offset)
+            prior_sig.append(s)
+            k += 1
+    pb = BundleProblem(
+        intrinsics=block.intrinsics,
+        image_camera=block.image_camera,
+        rotations=block.rotations,
+        centers=block.centers,
+        points=np.vstack(pts),
+        obs_image=np.concatenate(obs_img),
+        obs_point=np.concatenate(obs_pt),
+        obs_xy=np.vstack(obs_xy),
+        obs_sigma=np.concatenate(sig),
+        refine_intrinsics=cfg.refine_intrinsics,
+        point_prior_index=np.array(prior_idx, dtype=np.int64),
+        point_prior_xyz=np.array(prior_xyz).reshape(-1, 3),
+        point_prior_sigma=np.array(prior_sig).reshape(-1, 3),
+    )
+    if result.method == "gps":
+        ok = np.all(np.isfinite(gps_centers), axis=1)  # type: ignore[arg-type]
+        pb.center_prior_index = np.flatnonzero(ok)
+        pb.center_prior_xyz = gps_centers[ok]  # type: ignore[index]
+        pb.center_prior_sigma = np.tile(
+            [cfg.gps_sigma_xy, cfg.gps_sigma_xy, cfg.gps_sigma_z], (int(ok.sum()), 1)
+        )
+    conf = BundleConfig(max_iterations=cfg.max_iterations, loss="huber", loss_scale=cfg.loss_scale_px)
+    res = bundle_adjust(pb, conf, progress)
+    result.bundle = res
+    block.rotations, block.centers = res.rotations, res.centers
+    block.points = res.points[:n_tie]
+    for c, cam in enumerate(block.cameras):
+        block.cameras[c] = Camera.from_params(res.intrinsics[c], cam.width, cam.height, cam.id)
+
+    # control residuals (adjusted minus surveyed) and check points
+    if result.method == "gcp":
+        adj = res.points[n_tie:]
+        d = adj - np.array(prior_xyz)
+        used_ctrl = [g for g, ok in zip(control, usable, strict=True) if ok]
+        result.gcp_table = [
+            {"name": g.name, "dx": v[0], "dy": v[1], "dz": v[2], "views": int(len(g.observations))}
+            for g, v in zip(used_ctrl, d, strict=True)
+        ]
+        result.gcp_rmse = _rmse(d)
+        result.gcp_points = adj
+    if checks:
+        xyz, nv, err = triangulate_gcps(block, checks)
+        rows, ds = [], []
+        for g, p, n, e in zip(checks, xyz, nv, err, strict=True):
+            if not np.all(np.isfinite(p)):
+                result.warnings.append(
+                    f"check point {g.name}: {int(n)} observation(s) on oriented images; not evaluated"
+                )
+                continue
+            dv = p - (g.xyz - offset)
+            ds.append(dv)
+            rows.append(
+                {"name": g.name, "dx": dv[0], "dy": dv[1], "dz": dv[2], "views": int(n), "max_reproj_px": e}
+            )
+        result.check_table = rows
+        result.check_rmse = _rmse(np.array(ds).reshape(-1, 3))
+    return result
+
+
+def validate_gcps(gcps: list[GCP], image_names: set[str]) -> list[str]:
+    """Problems that make GCPs unusable, as messages (empty list: fine).
+
+    Raises :class:`InputError` for a GCP whose observations name no known image at all.
+    """
+    msgs = []
+    for g in gcps:
+        if not g.observations:
+            msgs.append(f"GCP {g.name} has no image observations")
+            continue
+        known = [o for o in g.observations if o[0] in image_names]
+        if not known:
+            raise InputError(
+                f"GCP {g.name}: its observations refer only to unknown images "
+                f"({', '.join(sorted({o[0] for o in g.observations}))})"
+            )
+    return msgs
+
+
+def block_from_reconstruction(
+    rec, obs_track, obs_image, obs_xy, image_names, cameras: list[Camera], image_camera
+):
+    """A :class:`Block` of the registered images and triangulated tracks of a reconstruction.
+
+    Returns the block and, for every block point, its track id.
+    """
+    reg = np.flatnonzero(rec.registered)
+    img_map = -np.ones(len(rec.registered), dtype=np.int64)
+    img_map[reg] = np.arange(len(reg))
+    ok = rec.point_ok
+    tracks = np.flatnonzero(ok)
+    pt_map = -np.ones(len(ok), dtype=np.int64)
+    pt_map[tracks] = np.arange(len(tracks))
+    use = np.flatnonzero(rec.obs_valid)
+    cams = [
+        Camera.from_params(rec.intrinsics[c], cam.width, cam.height, cam.id) for c, cam in enumerate(cameras)
+    ]
+    block = Block(
+        image_names=[image_names[i] for i in reg],
+        cameras=cams,
+        image_camera=np.asarray(image_camera)[reg],
+        rotations=rec.rotations[reg],
+        centers=rec.centers[reg],
+        points=rec.points[tracks],
+        obs_image=img_map[np.asarray(obs_image)[use]],
+        obs_point=pt_map[np.asarray(obs_track)[use]],
+        obs_xy=np.asarray(obs_xy)[use],
+    )
+    return block, tracks
