@@ -267,7 +267,16 @@ def georeference(
         d = adj - np.array(prior_xyz)
         used_ctrl = [g for g, ok in zip(control, usable, strict=True) if ok]
         result.gcp_table = [
-            {"name": g.name, "dx": v[0], "dy": v[1], "dz": v[2], "views": int(len(g.observations))}
+            {
+                "name": g.name,
+                "x": g.xyz[0],
+                "z": g.xyz[2],
+                "y": g.xyz[1],
+                "dx": v[0],
+                "dy": v[1],
+                "dz": v[2],
+                "views": int(len(g.observations)),
+            }
             for g, v in zip(used_ctrl, d, strict=True)
         ]
         result.gcp_rmse = _rmse(d)
@@ -284,7 +293,17 @@ def georeference(
             dv = p - (g.xyz - offset)
             ds.append(dv)
             rows.append(
-                {"name": g.name, "dx": dv[0], "dy": dv[1], "dz": dv[2], "views": int(n), "max_reproj_px": e}
+                {
+                    "name": g.name,
+                    "x": g.xyz[0],
+                    "y": g.xyz[1],
+                    "z": g.xyz[2],
+                    "dx": dv[0],
+                    "dy": dv[1],
+                    "dz": dv[2],
+                    "views": int(n),
+                    "max_reproj_px": e,
+                }
             )
         result.check_table = rows
         result.check_rmse = _rmse(np.array(ds).reshape(-1, 3))
