@@ -29,12 +29,12 @@ pytest: setup
 demo: setup
 	bash scripts/demo.sh
 
+# Benchmarks (not tests): each bench/bench_*.py prints its numbers and ratios against a peer
+# (pycolmap, OpenCV, Orthority) measured in the same run. make bench BENCH=bundle runs one.
+BENCH ?= *
 bench: setup
-	@if $(PY) -c 'import importlib.util as u, sys; sys.exit(u.find_spec("truortho.bench") is None)' 2>/dev/null; then \
-		$(ENV) $(PY) -P -m truortho.bench; \
-	else \
-		echo "bench: truortho.bench does not exist yet"; \
-	fi
+	$(ENV) $(PY) -m pip install -q -r requirements-bench.txt -c constraints.txt
+	@for f in bench/bench_$(BENCH).py; do echo "== $$f"; $(ENV) $(PY) -P $$f || exit 1; done
 
 zip:
 	@echo "zip: TODO (plugin zip for plugins.qgis.org)"; exit 1
