@@ -1,0 +1,173 @@
+"""Procedural colour of the synthetic surface (3D value noise).
+
+The colour of a surface point is ``base(material, building) * shade(x, y, z)``
+with ``shade`` a contrast-stretched multi-octave 3D value noise: octave
+lattice spacings ``texture_scale * 2**k``, ``k = 0 .. octaves-1`` (about 1 to
+20 GSD with the defaults), so the texture is matchable at every scale. Ground
+mixes two base colours with a slow noise; every roof and every building's
+walls have their own base colour, chosen so that ground, roof and wall colours
+are far apart (CIE76 ΔE*ab well above 25 between the bases).
+
+Colours are floats in [0, 1] (display RGB, no gamma handling: they *are* the
+pixel values divided by 255).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..jit import njit, pjit, prange
+
+GROUND = 0
+ROOF = 1
+WALL = 2
+SKY = -1
+
+SKY_RGB = (0.62, 0.76, 0.92)
+
+GROUND_RGB = ((0.30, 0.50, 0.20), (0.55, 0.45, 0.30))
+ROOF_RGB = (
+    (0.78, 0.26, 0.18),  # terracotta
+    (0.24, 0.34, 0.70),  # slate blue
+    (0.90, 0.58, 0.10),  # orange
+    (0.58, 0.22, 0.62),  # purple
+    (0.15, 0.62, 0.70),  # teal
+    (0.85, 0.20, 0.45),  # raspberry
+)
+WALL_RGB = (
+    (0.93, 0.90, 0.80),  # cream
+    (0.86, 0.86, 0.92),  # light grey-blue
+    (0.95, 0.84, 0.84),  # pale pink
+    (0.90, 0.93, 0.78),  # pale yellow-green
+)
+
+
+def palette(n_buildings: int) -> np.ndarray:
+    """Base colours, shape ``(2 + 2 n, 3)`` float64.
+
+    Rows 0 and 1: ground; row ``2 + 2 b``: roof of building ``b``; row
+    ``3 + 2 b``: its walls.
+    """
+    pal = np.zeros((2 + 2 * n_buildings, 3))
+    pal[0], pal[1] = GROUND_RGB
+    for b in range(n_buildings):
+        pal[2 + 2 * b] = ROOF_RGB[b % len(ROOF_RGB)]
+        pal[3 + 2 * b] = WALL_RGB[b % len(WALL_RGB)]
+    return pal
+
+
+def texture_params(seed: int, scale: float, octaves: int, contrast: float) -> np.ndarray:
+    """Packed texture parameters for the kernels: ``[seed, scale, octaves, contrast]``."""
+    return np.array([float(seed), float(scale), float(octaves), float(contrast)])
+
+
+# ---------------------------------------------------------------- kernels
+
+
+@njit
+def _hash01(ix, iy, iz, seed):
+    h = ((ix * 73856093) ^ (iy * 19349663) ^ (iz * 83492791) ^ (seed * 2654435761)) & 0xFFFFFFFF
+    h = (((h >> 15) ^ h) * 0x2C1B3C6D) & 0xFFFFFFFF
+    h = (h >> 12) ^ h
+    return (h & 0xFFFFFF) / 16777215.0
+
+
+@njit
+def _fade(t):
+    return t * t * t * (t * (t * 6.0 - 15.0) + 10.0)
+
+
+@njit
+def _value_noise(x, y, z, seed):
+    """Smooth value noise in [0, 1] on the unit lattice."""
+    fx = np.floor(x)
+    fy = np.floor(y)
+    fz = np.floor(z)
+    ix = np.int64(fx)
+    iy = np.int64(fy)
+    iz = np.int64(fz)
+    u = _fade(x - fx)
+    v = _fade(y - fy)
+    w = _fade(z - fz)
+    c000 = _hash01(ix, iy, iz, seed)
+    c100 = _hash01(ix + 1, iy, iz, seed)
+    c010 = _hash01(ix, iy + 1, iz, seed)
+    c110 = _hash01(ix + 1, iy + 1, iz, seed)
+    c001 = _hash01(ix, iy, iz + 1, seed)
+    c101 = _hash01(ix + 1, iy, iz + 1, seed)
+    c011 = _hash01(ix, iy + 1, iz + 1, seed)
+    c111 = _hash01(ix + 1, iy + 1, iz + 1, seed)
+    a = c000 + u * (c100 - c000)
+    b = c010 + u * (c110 - c010)
+    c = c001 + u * (c101 - c001)
+    d = c011 + u * (c111 - c011)
+    e = a + v * (b - a)
+    f = c + v * (d - c)
+    return e + w * (f - e)
+
+
+@njit
+def _fbm(x, y, z, seed, scale, octaves):
+    """Multi-octave noise in [0, 1]; finest lattice spacing ``scale``."""
+    total = 0.0
+    norm = 0.0
+    amp = 1.0
+    s = scale * 2.0 ** (octaves - 1)
+    for k in range(octaves):
+        total += amp * _value_noise(x / s, y / s, z / s, seed + 101 * k)
+        norm += amp
+        amp *= 0.8
+        s *= 0.5
+    return total / norm
+
+
+@njit
+def _colour(x, y, z, mat, b, pal, tex):
+    """RGB in [0, 1] of the surface point (x, y, z) of material ``mat`` (building ``b``)."""
+    seed = np.int64(tex[0])
+    n = _fbm(x, y, z, seed + 37 * mat, tex[1], np.int64(tex[2]))
+    v = 0.5 + tex[3] * (n - 0.5)
+    v = min(max(v, 0.0), 1.0)
+    shade = 0.45 + 0.9 * v
+    if mat == 0:
+        m = _value_noise(x / 9.0, y / 9.0, z / 9.0, seed + 5)
+        m = min(max(2.0 * m - 0.5, 0.0), 1.0)
+        r = (1.0 - m) * pal[0, 0] + m * pal[1, 0]
+        g = (1.0 - m) * pal[0, 1] + m * pal[1, 1]
+        bl = (1.0 - m) * pal[0, 2] + m * pal[1, 2]
+    else:
+        row = 2 + 2 * b + (1 if mat == 2 else 0)
+        r = pal[row, 0]
+        g = pal[row, 1]
+        bl = pal[row, 2]
+    return min(r * shade, 1.0), min(g * shade, 1.0), min(bl * shade, 1.0)
+
+
+@pjit
+def _colour_many(pts, mat, bid, pal, tex):
+    n = pts.shape[0]
+    out = np.empty((n, 3))
+    for i in prange(n):
+        r, g, b = _colour(pts[i, 0], pts[i, 1], pts[i, 2], mat[i], bid[i], pal, tex)
+        out[i, 0] = r
+        out[i, 1] = g
+        out[i, 2] = b
+    return out
+
+
+def srgb_to_lab(rgb) -> np.ndarray:
+    """CIE L*a*b* (D65) of sRGB colours in [0, 1], shape (..., 3) -> (..., 3).
+
+    For ΔE*ab (CIE76) checks: ``np.linalg.norm(lab1 - lab2, axis=-1)``.
+    """
+    c = np.clip(np.asarray(rgb, dtype=np.float64), 0.0, 1.0)
+    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    M = np.array([[0.4124564, 0.3575761, 0.1804375],
+                  [0.2126729, 0.7151522, 0.0721750],
+                  [0.0193339, 0.1191920, 0.9503041]])
+    xyz = lin @ M.T / np.array([0.95047, 1.0, 1.08883])
+    f = np.where(xyz > (6 / 29) ** 3, np.cbrt(xyz), xyz / (3 * (6 / 29) ** 2) + 4 / 29)
+    L = 116 * f[..., 1] - 16
+    a = 500 * (f[..., 0] - f[..., 1])
+    b = 200 * (f[..., 1] - f[..., 2])
+    return np.stack([L, a, b], axis=-1)
