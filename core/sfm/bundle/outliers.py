@@ -77,7 +77,7 @@ def adjust_with_outlier_rejection(
             obs_image=problem.obs_image[keep],
             obs_point=problem.obs_point[keep],
             obs_xy=problem.obs_xy[keep],
-            obs_sigma=problem.obs_sigma[keep],
+            obs_sigma=np.asarray(problem.obs_sigma)[keep],
         )
         res = bundle_adjust(sub, rerun_cfg, steps[rnd + 1])
         full_r = _full_residuals(problem, res)

@@ -285,7 +285,8 @@ def build_layout(problem: BundleProblem, gauge: str = "auto") -> Layout:
     pose_cols[free] = np.arange(int(free.sum()))
     n = int(free.sum())
     intr_cols = np.full((n_cam, len(INTRINSIC_NAMES)), -1, dtype=np.int64)
-    for c, names in enumerate(problem.refine_intrinsics):
+    refine_sets: list[frozenset[str]] = list(problem.refine_intrinsics)  # type: ignore[call-overload]
+    for c, names in enumerate(refine_sets):
         if not cam_seen[c]:
             continue
         for k, name in enumerate(INTRINSIC_NAMES):

@@ -86,8 +86,9 @@ class _Evaluator:
 
     def __init__(self, pb: BundleProblem, cfg: BundleConfig, active: np.ndarray | None = None):
         self.pb, self.cfg = pb, cfg
-        self.inv_s2 = 1.0 / pb.obs_sigma**2
-        self.active = active
+        self.inv_s2 = 1.0 / np.asarray(pb.obs_sigma, dtype=np.float64) ** 2
+        # observations taking part; fixed at the first linearisation when None
+        self.active: np.ndarray = active  # type: ignore[assignment]
         n = pb.n_observations
         self.r = np.zeros((n, 2))
         self.valid = np.zeros(n, dtype=np.bool_)
