@@ -282,9 +282,9 @@ def georeference(
         result.gcp_rmse = _rmse(d)
         result.gcp_points = adj
     if checks:
-        xyz, nv, err = triangulate_gcps(block, checks)
+        xyz, nv, reproj = triangulate_gcps(block, checks)
         rows, ds = [], []
-        for g, p, n, e in zip(checks, xyz, nv, err, strict=True):
+        for g, p, n, e in zip(checks, xyz, nv, reproj, strict=True):
             if not np.all(np.isfinite(p)):
                 result.warnings.append(
                     f"check point {g.name}: {int(n)} observation(s) on oriented images; not evaluated"

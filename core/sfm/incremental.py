@@ -313,7 +313,7 @@ def _resect(st: _State, i: int, cfg: IncrementalConfig):
         obj,
         img,
         np.eye(3),
-        None,
+        np.zeros(4),
         iterationsCount=2000,
         reprojectionError=cfg.pnp_threshold_px / f,
         confidence=0.9999,
@@ -322,7 +322,7 @@ def _resect(st: _State, i: int, cfg: IncrementalConfig):
     if not ok or inl is None or len(inl) < cfg.min_pnp_inliers:
         return None, 0 if inl is None else len(inl)
     inl = inl.ravel()
-    rvec, tvec = cv2.solvePnPRefineLM(obj[inl], img[inl], np.eye(3), None, rvec, tvec)
+    rvec, tvec = cv2.solvePnPRefineLM(obj[inl], img[inl], np.eye(3), np.zeros(4), rvec, tvec)
     R, _ = cv2.Rodrigues(rvec)
     C = (-R.T @ tvec).ravel()
     # mark outlier observations of this image
