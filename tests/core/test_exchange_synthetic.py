@@ -29,7 +29,9 @@ def _max_gcp_error(orientation, gcps) -> tuple[float, int]:
     for g in gcps:
         for name, x, y in g.observations:
             im = orientation.image(name)
-            uv = project_points(orientation.frame.to_local(g.xyz[None]), im.R, im.C, orientation.camera_of(im))[0]
+            uv = project_points(
+                orientation.frame.to_local(g.xyz[None]), im.R, im.C, orientation.camera_of(im)
+            )[0]
             worst = max(worst, float(np.hypot(uv[0] - x, uv[1] - y)))
             n += 1
     return worst, n
