@@ -9,10 +9,12 @@ from .environment import EnvironmentAlgorithm
 from .exportorientation import ExportOrientationAlgorithm
 from .importgcps import ImportGcpsAlgorithm
 from .importorientation import ImportOrientationAlgorithm
+from .orientimages import OrientImagesAlgorithm
 
 ALGORITHMS: list[type] = [
     EnvironmentAlgorithm,
     ImportOrientationAlgorithm,
     ExportOrientationAlgorithm,
     ImportGcpsAlgorithm,
+    OrientImagesAlgorithm,
 ]

@@ -71,6 +71,41 @@ HELP: dict[str, dict] = {
             "top-left pixel, as in gcp_list.txt).",
         },
     },
+    "orientimages": {
+        "summary": (
+            "Orients a block of overlapping photos: SIFT features at a working resolution, pair selection "
+            "(exhaustive for small blocks, EXIF GNSS footprints, or a low-resolution retrieval pass), robust "
+            "two-view geometry, tie-point tracks decimated on a grid by multiplicity, incremental "
+            "reconstruction and a bundle block adjustment written for TruOrtho (collinearity equations with "
+            "Brown distortion, Levenberg-Marquardt with the Schur complement, Huber loss, self-calibration). "
+            "Ground control fixes the datum (7-parameter similarity, then weighted GCP observations); check "
+            "points never enter the adjustment and are reported with per-axis RMSE. Without GCPs, EXIF GNSS "
+            "positions serve as weighted priors; without either the block stays in an arbitrary frame."
+        ),
+        "parameters": {
+            "IMAGES": "Folder of the images (non-image files are skipped with a warning in the report).",
+            "IMAGE_FILES": "The image files, instead of a folder.",
+            "CAMERA": "Interior orientation: an Orthority interior file (YAML/JSON) or a text file with the "
+            "3x3 matrix K. Without it: EXIF focal length and sensor size, else f = 1.2 x max(w, h); "
+            "refined by self-calibration.",
+            "GCPS": "Ground control and check points: point layer with 'name', 'role' (gcp|check), PointZ or "
+            "'z', optional 'sigma_xy'/'sigma_z' (metres). Reprojected to CRS.",
+            "OBSERVATIONS": "Image measurements of the GCPs: table with 'gcp', 'image' (file name), 'x', 'y' "
+            "(pixels, (0, 0) = centre of the top-left pixel).",
+            "CRS": "CRS of the output (default: the GCP layer's, else the UTM zone of the EXIF GNSS positions).",
+            "WORKING_SIZE": "Larger image side at which features are detected, pixels.",
+            "MAX_FEATURES": "Features kept per image.",
+            "SELF_CALIBRATION": "Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment (else hold the interior "
+            "orientation).",
+            "ORIENTATION": "The adjusted orientation (TruOrtho JSON).",
+            "REPORT": "HTML report (and a JSON file of the same name): sigma0, image RMS, per-image "
+            "residuals, GCP and check point tables, residual vector plots, tie-point multiplicity "
+            "histogram, block overview.",
+            "CAMERAS": "Projection centres (PointZ) with omega, phi, kappa.",
+            "TIE_POINTS": "Tie points (PointZ) with multiplicity, mean reprojection error and colour.",
+            "GCP_RESIDUALS": "GCPs and check points with dX, dY, dZ (adjusted or triangulated minus surveyed).",
+        },
+    },
 }
 
 

@@ -1,0 +1,454 @@
+"""Image orientation from photos (and ground control) to an adjusted :class:`Orientation`.
+
+Stages (each reports progress and honours cancel):
+
+1. image inventory (non-image files are skipped with a warning), EXIF,
+   interior-orientation priors (a given file; EXIF focal length and sensor;
+   or the documented default ``f = 1.2 max(w, h)``), one camera per
+   (size, make, model, focal length) group;
+2. SIFT features at the working resolution (cached);
+3. pair selection (exhaustive for small blocks, EXIF GNSS footprints, or a
+   low-resolution retrieval pass) and robust two-view verification;
+4. tracks, decimated on a grid per image by multiplicity;
+5. incremental reconstruction with bundle adjustment (:mod:`.incremental`);
+6. datum: GCPs with check points, else EXIF GNSS priors, else an arbitrary
+   frame (:mod:`.georef`); final adjustment;
+7. the orientation (JSON model), tie points and the report.
+"""
+
+from __future__ import annotations
+
+import os
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import FormatError, InputError, MissingFileError
+from ..geometry.camera import Camera
+from ..geometry.frame import (
+    LocalFrame,
+    choose_offset,
+    crs_to_text,
+    parse_crs,
+    require_metric,
+    transform_points,
+)
+from ..orientation import GCP, Image, Orientation, SparsePoints
+from ..progress import Progress, Steps, as_progress, check
+from ..report import Report
+from .bundle import BundleConfig, BundleProblem, bundle_adjust
+from .georef import Block, GeorefConfig, GeorefResult, block_from_reconstruction, georeference, validate_gcps
+from .incremental import IncrementalConfig, reconstruct
+from .report import orientation_report
+
+ALL_INTRINSICS = ("f", "cx", "cy", "k1", "k2", "p1", "p2")
+
+
+@dataclass
+class OrientConfig:
+    """Options of :func:`orient_images`."""
+
+    #: Larger image side at which features are detected, pixels.
+    working_size: int = 2000
+    #: Features per image.
+    max_features: int = 8000
+    #: Self-calibrate f, cx, cy, k1, k2, p1, p2 (else the interior orientation is held).
+    self_calibration: bool = True
+    #: Tie-point decimation grid cell, pixels at full resolution (None: max(w, h) / 50).
+    decimation_cell_px: float | None = None
+    #: Pair selection strategy: auto, exhaustive, gps, retrieval.
+    pair_strategy: str = "auto"
+    incremental: IncrementalConfig = field(default_factory=IncrementalConfig)
+    georef: GeorefConfig = field(default_factory=GeorefConfig)
+
+
+@dataclass
+class OrientationRun:
+    """Products of :func:`orient_images`.
+
+    Attributes
+    ----------
+    orientation : Orientation
+    report : Report
+    tie_xyz : (P, 3)
+        Tie points in the world CRS (or the arbitrary frame).
+    tie_multiplicity, tie_error, tie_rgb : (P,), (P,), (P, 3)
+        Images per point, mean reprojection error (px), colour.
+    gcp_residuals : list of dict
+        ``name, role, x, y, z, dx, dy, dz, views`` (adjusted/triangulated minus surveyed).
+    """
+
+    orientation: Orientation
+    report: Report
+    tie_xyz: np.ndarray
+    tie_multiplicity: np.ndarray
+    tie_error: np.ndarray
+    tie_rgb: np.ndarray
+    gcp_residuals: list[dict]
+
+
+def read_k_matrix(path) -> np.ndarray:
+    """A 3x3 calibration matrix from a text file (3 rows of 3 numbers)."""
+    try:
+        rows = [ln.split() for ln in open(path, encoding="utf-8").read().splitlines() if ln.strip()]
+        K = np.array([[float(v) for v in r] for r in rows])
+    except (OSError, UnicodeDecodeError, ValueError) as err:
+        raise FormatError(path, f"expected a 3x3 matrix of numbers: {err}") from None
+    if K.shape != (3, 3) or not np.all(np.isfinite(K)) or K[0, 0] <= 0 or K[1, 1] <= 0:
+        raise FormatError(
+            path, f"expected a 3x3 calibration matrix with positive focal lengths, got shape {K.shape}"
+        )
+    return K
+
+
+def _camera_priors(paths, infos, exifs, camera_file, warnings):
+    """Cameras (list) and the camera index of every image."""
+    from ..exif import focal_prior_px
+
+    if camera_file:
+        if not os.path.isfile(camera_file):
+            raise MissingFileError(camera_file, "interior orientation file (CAMERA) not found")
+        if str(camera_file).lower().endswith((".yaml", ".yml", ".json")):
+            from ..formats.opk import read_interior
+
+            cams, w = read_interior(camera_file)
+            warnings += w
+            cam_list = list(cams.values())
+            if len(cam_list) != 1:
+                raise InputError(
+                    f"{camera_file}: {len(cam_list)} cameras defined; exactly one is supported here"
+                )
+            cam = cam_list[0]
+        else:
+            K = read_k_matrix(camera_file)
+            cam = Camera(infos[0].width, infos[0].height, K[0, 0], K[1, 1], K[0, 2], K[1, 2], id="camera")
+        for p, info in zip(paths, infos, strict=True):
+            if (info.width, info.height) != (cam.width, cam.height):
+                raise InputError(
+                    f"{p}: image size {info.width}x{info.height} differs from the camera's "
+                    f"{cam.width}x{cam.height} in {camera_file}"
+                )
+        return (
+            [cam],
+            np.zeros(len(paths), dtype=np.int64),
+            {"interior": f"file {os.path.basename(camera_file)}"},
+        )
+    groups: dict[tuple, int] = {}
+    cams: list[Camera] = []
+    index = np.zeros(len(paths), dtype=np.int64)
+    sources = {}
+    for k, (info, ex) in enumerate(zip(infos, exifs, strict=True)):
+        key = (
+            info.width,
+            info.height,
+            ex.make if ex else None,
+            ex.model if ex else None,
+            ex.focal_mm if ex else None,
+        )
+        if key not in groups:
+            f, source = focal_prior_px(ex, info.width, info.height)
+            name = f"camera{len(cams) + 1}" if not (ex and ex.model) else f"{ex.model} {len(cams) + 1}"
+            cams.append(
+                Camera(info.width, info.height, f, f, (info.width - 1) / 2, (info.height - 1) / 2, id=name)
+            )
+            groups[key] = len(cams) - 1
+            sources[name] = source
+            if source == "default":
+                warnings.append(
+                    f"{name}: no usable EXIF focal length; starting from f = 1.2 x max(w, h) = {f:.0f} px "
+                    "(refined by self-calibration)"
+                )
+        index[k] = groups[key]
+    return cams, index, {"interior": sources}
+
+
+def _inventory(paths, warnings):
+    from ..imagery import image_info
+
+    ok_paths, infos = [], []
+    for p in paths:
+        try:
+            infos.append(image_info(p))
+            ok_paths.append(os.fspath(p))
+        except (FormatError, MissingFileError) as err:
+            warnings.append(f"skipped {os.path.basename(os.fspath(p))}: not a readable image ({err})")
+    if len(ok_paths) < 2:
+        raise InputError(f"IMAGES: at least two images are needed, found {len(ok_paths)} readable image(s)")
+    return ok_paths, infos
+
+
+def _gps_local(exifs, crs_text_, warnings):
+    """EXIF GNSS positions in the CRS (world), NaN where absent; the CRS used."""
+    have = [e is not None and e.has_gps and e.altitude is not None for e in exifs]
+    if sum(have) < 3:
+        return None, crs_text_
+    lat = np.array([e.latitude if h else np.nan for e, h in zip(exifs, have, strict=True)])
+    lon = np.array([e.longitude if h else np.nan for e, h in zip(exifs, have, strict=True)])
+    alt = np.array([e.altitude if h else np.nan for e, h in zip(exifs, have, strict=True)])
+    if crs_text_ is None:
+        from pyproj.aoi import AreaOfInterest
+        from pyproj.database import query_utm_crs_info
+
+        info = query_utm_crs_info(
+            "WGS 84", AreaOfInterest(*(2 * [float(np.nanmean(lon))]), *(2 * [float(np.nanmean(lat))]))[:4]
+        )
+        crs_text_ = f"EPSG:{info[0].code}" if info else None
+        if crs_text_ is None:
+            return None, None
+        warnings.append(f"no CRS given: using {crs_text_} (UTM zone of the GNSS positions)")
+    xyz = transform_points(np.column_stack([lon, lat, alt]), "EPSG:4979", crs_text_)
+    xyz[~np.array(have)] = np.nan
+    return xyz, crs_text_
+
+
+def orient_images(
+    paths,
+    camera_file=None,
+    gcps: list[GCP] | None = None,
+    crs: str | None = None,
+    config: OrientConfig | None = None,
+    work_dir=None,
+    progress: Progress | None = None,
+) -> OrientationRun:
+    """Orient a block of images (see the module docstring).
+
+    Parameters
+    ----------
+    paths : list of path
+        Image files (other files are skipped with a warning).
+    camera_file : path, optional
+        Orthority interior file (YAML/JSON) or a 3x3 K matrix text file.
+    gcps : list of GCP, optional
+        World coordinates in ``crs``, with image measurements by image file name.
+    crs : str, optional
+        CRS of the GCPs and the output (default: the UTM zone of EXIF GNSS, else none).
+    work_dir : path, optional
+        Feature cache.
+    """
+    from ..exif import read_exif
+    from .features import FeatureConfig, extract_all
+    from .matching import match_pairs
+    from .pairs import PairConfig, select_pairs
+    from .tracks import tracks_from_pairs
+
+    cfg = config or OrientConfig()
+    prog = as_progress(progress)
+    steps = Steps(prog, [1, 10, 10, 1, 8, 3, 1])
+    t_start = time.perf_counter()
+    times: dict[str, float] = {}
+    warnings: list[str] = []
+    gcps = list(gcps or [])
+    if crs is not None:
+        pc = parse_crs(crs)
+        require_metric(pc, "CRS")
+        crs = crs_to_text(pc)
+
+    t = time.perf_counter()
+    paths, infos = _inventory(list(paths), warnings)
+    names = [os.path.basename(p) for p in paths]
+    if len(set(names)) != len(names):
+        raise InputError("IMAGES: two images share a file name; GCP measurements refer to images by name")
+    if gcps:
+        warnings += validate_gcps(gcps, set(names))
+        if crs is None:
+            raise InputError("GCPS: ground control needs a CRS (give CRS or a GCP layer with a CRS)")
+    exifs = []
+    for k, p in enumerate(paths):
+        check(prog)
+        steps[0].update(k / len(paths), "reading EXIF")
+        exifs.append(read_exif(p))
+    cams, image_camera, cam_info = _camera_priors(paths, infos, exifs, camera_file, warnings)
+    times["inventory"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    fcfg = FeatureConfig(max_dimension=cfg.working_size, max_features=cfg.max_features)
+    cache = os.path.join(work_dir, "features") if work_dir else None
+    features, fstats = extract_all(paths, fcfg, cache, steps[1])
+    times["features"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    sizes = np.array([[i.width, i.height] for i in infos])
+    focals = np.array([cams[c].fx for c in image_camera])
+    sel = select_pairs(paths, exifs, sizes, focals, PairConfig(strategy=cfg.pair_strategy), cache, None)
+    per_image_cams = [cams[c] for c in image_camera]
+    results, mstats = match_pairs(features, sel.pairs, per_image_cams, progress=steps[2])
+    n_verified = sum(r.ok for r in results)
+    times["matching"] = time.perf_counter() - t
+    if n_verified == 0:
+        raise InputError(
+            "IMAGES: no image pair could be matched; the images do not overlap "
+            f"({sel.n_pairs} pairs tried, strategy {sel.strategy})"
+        )
+
+    t = time.perf_counter()
+    cell = cfg.decimation_cell_px or max(float(sizes.max()) / 50.0, 8.0)
+    tracks = tracks_from_pairs(features, results, cell)
+    steps[3].update(1.0, f"{tracks.n_tracks} tie points after decimation")
+    times["tracks"] = time.perf_counter() - t
+
+    t = time.perf_counter()
+    inc = cfg.incremental
+    if not cfg.self_calibration:
+        inc.refine_intrinsics = ()
+        inc.refine_focal_early = False
+    elif camera_file:
+        inc.refine_focal_early = False
+    rec = reconstruct(tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, steps[4])
+    times["reconstruction"] = time.perf_counter() - t
+    n_reg = int(rec.registered.sum())
+    if n_reg < 2:
+        raise InputError(f"orientation failed: {rec.stats.get('failure', 'no initial pair')}")
+    for k in np.flatnonzero(~rec.registered):
+        warnings.append(f"image {names[k]} could not be oriented (too few tie points with the block)")
+
+    t = time.perf_counter()
+    block, track_ids = block_from_reconstruction(
+        rec, tracks.track, tracks.image, tracks.xy, names, cams, image_camera
+    )
+    gcfg = cfg.georef
+    gcfg.refine_intrinsics = ALL_INTRINSICS if cfg.self_calibration else ()
+    gps_world, crs = _gps_local(exifs, crs, warnings) if not gcps else (None, crs)
+    offset = np.zeros(3)
+    if gcps:
+        offset = choose_offset(np.array([g.xyz for g in gcps]))
+    elif gps_world is not None:
+        offset = choose_offset(gps_world[np.all(np.isfinite(gps_world), axis=1)])
+    gps_local = None if gps_world is None else (gps_world - offset)[rec.registered]
+    geo = georeference(block, gcps, offset, gps_local, gcfg, steps[5])
+    if geo.method == "none":
+        bundle = _adjust_free(block, gcfg)
+        crs_out = None
+        offset = np.zeros(3)
+        if crs is not None:
+            warnings.append(
+                "no usable ground control or GNSS: the orientation is in an arbitrary frame, without CRS"
+            )
+    else:
+        bundle = geo.bundle
+        crs_out = crs
+    times["georeferencing"] = time.perf_counter() - t
+
+    orientation, tie = _build_orientation(
+        block, track_ids, tracks, features, bundle, paths, rec, crs_out, offset, gcps
+    )
+    steps[6].update(1.0, "report")
+    times["total"] = time.perf_counter() - t_start
+    stats = {
+        "summary": {
+            "pairs tried": f"{sel.n_pairs} of {sel.n_exhaustive} ({sel.strategy})",
+            "verified pairs": n_verified,
+            "tie points before decimation": tracks.stats.get("decimation", {}).get(
+                "tracks_before", tracks.n_tracks
+            ),
+            "wall time [s]": round(times["total"], 1),
+        },
+        "timings": times,
+        "features": {k: v for k, v in fstats.items() if k != "seconds_per_image"},
+        "pairs": {
+            "strategy": sel.strategy,
+            "tried": sel.n_pairs,
+            "exhaustive": sel.n_exhaustive,
+            "verified": n_verified,
+        },
+        "matching": mstats,
+        "tracks": tracks.stats,
+        "reconstruction": rec.stats,
+        "cameras": cam_info,
+        "warnings": warnings,
+    }
+    reg_idx = np.flatnonzero(rec.registered)
+    rep = orientation_report(
+        "TruOrtho orientation report",
+        names,
+        rec.registered,
+        orientation.frame.to_world(np.array([im.C for im in orientation.images])),
+        tie["xyz"],
+        tie["multiplicity"],
+        bundle,
+        block.obs_image,
+        block.obs_xy,
+        geo if geo.method != "none" else GeorefResult("none", warnings=geo.warnings),
+        stats,
+        block.cameras,
+    )
+    rep.data["registered_images"] = [names[i] for i in reg_idx]
+    residuals = [{**r, "role": "gcp"} for r in geo.gcp_table] + [
+        {**r, "role": "check"} for r in geo.check_table
+    ]
+    prog.update(1.0, f"oriented {n_reg} of {len(paths)} images")
+    return OrientationRun(
+        orientation, rep, tie["xyz"], tie["multiplicity"], tie["error"], tie["rgb"], residuals
+    )
+
+
+def _adjust_free(block: Block, gcfg: GeorefConfig):
+    pb = BundleProblem(
+        intrinsics=block.intrinsics,
+        image_camera=block.image_camera,
+        rotations=block.rotations,
+        centers=block.centers,
+        points=block.points,
+        obs_image=block.obs_image,
+        obs_point=block.obs_point,
+        obs_xy=block.obs_xy,
+        refine_intrinsics=gcfg.refine_intrinsics,
+    )
+    res = bundle_adjust(
+        pb, BundleConfig(max_iterations=gcfg.max_iterations, loss="huber", loss_scale=gcfg.loss_scale_px)
+    )
+    block.rotations, block.centers, block.points = res.rotations, res.centers, res.points
+    for c, cam in enumerate(block.cameras):
+        block.cameras[c] = Camera.from_params(res.intrinsics[c], cam.width, cam.height, cam.id)
+    return res
+
+
+def _build_orientation(block, track_ids, tracks, features, bundle, paths, rec, crs, offset, gcps):
+    names = block.image_names
+    root = os.path.commonpath([os.path.dirname(os.path.abspath(p)) for p in paths])
+    rel = {os.path.basename(p): os.path.relpath(os.path.abspath(p), root).replace(os.sep, "/") for p in paths}
+    cameras = {c.id: c for c in block.cameras}
+    images = [
+        Image(n, block.cameras[block.image_camera[k]].id, block.rotations[k], block.centers[k], rel[n])
+        for k, n in enumerate(names)
+    ]
+    # colours and errors per point
+    n_pt = len(block.points)
+    rgb_sum = np.zeros((n_pt, 3))
+    n_obs = len(block.obs_image)
+    err = np.linalg.norm(bundle.residuals[:n_obs], axis=1)
+    err_sum = np.bincount(block.obs_point, weights=np.nan_to_num(err), minlength=n_pt)
+    # block observations are the reconstruction's valid track observations, in order
+    obs_sel = np.flatnonzero(rec.obs_valid)
+    feat = tracks.feature[obs_sel]
+    img_full = tracks.image[obs_sel]
+    colours = np.zeros((n_obs, 3))
+    for k in np.unique(img_full):
+        sel = img_full == k
+        colours[sel] = features[k].colors[feat[sel]]
+    np.add.at(rgb_sum, block.obs_point, colours)
+    cnt = np.bincount(block.obs_point, minlength=n_pt).astype(np.float64)
+    cnt1 = np.maximum(cnt, 1)
+    rgb = rgb_sum / cnt1[:, None]
+    mean_err = err_sum / cnt1
+    pts = SparsePoints(block.points, rgb, mean_err, block.obs_point, block.obs_image, block.obs_xy)
+    frame = LocalFrame(crs, offset)
+    o = Orientation(
+        frame,
+        cameras,
+        images,
+        pts,
+        list(gcps),
+        root,
+        {
+            "generator": "truortho:orientimages",
+            "unregistered": [os.path.basename(paths[i]) for i in np.flatnonzero(~rec.registered)],
+        },
+    )
+    tie = {
+        "xyz": frame.to_world(block.points),
+        "multiplicity": cnt.astype(np.int64),
+        "error": mean_err,
+        "rgb": np.clip(np.round(rgb), 0, 255).astype(np.uint8),
+    }
+    return o, tie
