@@ -92,18 +92,20 @@ HELP: dict[str, dict] = {
             "'z', optional 'sigma_xy'/'sigma_z' (metres). Reprojected to CRS.",
             "OBSERVATIONS": "Image measurements of the GCPs: table with 'gcp', 'image' (file name), 'x', 'y' "
             "(pixels, (0, 0) = centre of the top-left pixel).",
-            "CRS": "CRS of the output (default: the GCP layer's, else the UTM zone of the EXIF GNSS positions).",
+            "CRS": "CRS of the output (default: the GCP layer's, else the UTM zone of the EXIF GNSS "
+            "positions).",
             "WORKING_SIZE": "Larger image side at which features are detected, pixels.",
             "MAX_FEATURES": "Features kept per image.",
-            "SELF_CALIBRATION": "Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment (else hold the interior "
-            "orientation).",
+            "SELF_CALIBRATION": "Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment (else hold the "
+            "interior orientation).",
             "ORIENTATION": "The adjusted orientation (TruOrtho JSON).",
             "REPORT": "HTML report (and a JSON file of the same name): sigma0, image RMS, per-image "
             "residuals, GCP and check point tables, residual vector plots, tie-point multiplicity "
             "histogram, block overview.",
             "CAMERAS": "Projection centres (PointZ) with omega, phi, kappa.",
             "TIE_POINTS": "Tie points (PointZ) with multiplicity, mean reprojection error and colour.",
-            "GCP_RESIDUALS": "GCPs and check points with dX, dY, dZ (adjusted or triangulated minus surveyed).",
+            "GCP_RESIDUALS": "GCPs and check points with dX, dY, dZ (adjusted or triangulated minus "
+            "surveyed).",
         },
     },
 }
