@@ -1,0 +1,228 @@
+"""Features, matching, two-view geometry and pair selection on the shared real data.
+
+fountain-P11 at a 1000 px working resolution against its ground-truth cameras
+(R in the .camera files is camera-to-world: ours is its transpose), brighton
+GPS pair selection, copr retrieval. Timings are printed (``pytest -s``).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from truortho.core.errors import CancelledError, FormatError, InputError
+from truortho.core.geometry import Camera
+from truortho.core.progress import CallbackProgress
+from truortho.core.sfm.features import FeatureConfig, cache_path, extract_all, extract_features
+from truortho.core.sfm.matching import MatchConfig, match_descriptors, match_pairs
+from truortho.core.sfm.pairs import PairConfig, exhaustive_pairs, select_pairs
+from truortho.core.sfm.twoview import TwoViewConfig, estimate_two_view
+
+DATA = Path("/work/shared/data")
+FOUNTAIN = DATA / "fountain-P11"
+pytestmark = pytest.mark.skipif(not DATA.is_dir(), reason="shared data sets not available")
+
+
+def _rot_angle_deg(Ra, Rb) -> float:
+    import cv2
+
+    v, _ = cv2.Rodrigues(Ra.T @ Rb)
+    return float(np.degrees(np.linalg.norm(v)))
+
+
+def _gt_pose(i: int):
+    v = np.loadtxt(FOUNTAIN / f"gt_dense_cameras/{i:04d}.jpg.camera", max_rows=8)
+    return v[4:7].T, v[7]  # world->camera R (file: camera->world), centre
+
+
+@pytest.fixture(scope="module")
+def fountain(tmp_path_factory):
+    cache = tmp_path_factory.mktemp("features")
+    paths = [FOUNTAIN / f"images/{i:04d}.jpg" for i in range(11)]
+    feats, st = extract_all(paths, FeatureConfig(max_dimension=1000), cache_dir=cache)
+    print(f"\nSIFT @1000 px: {np.mean(st['seconds_per_image']):.2f} s/image, {st['n_features']} features")
+    K = np.loadtxt(FOUNTAIN / "images/K.txt")
+    cam = Camera(3072, 2048, K[0, 0], K[1, 1], K[0, 2], K[1, 2])
+    return paths, feats, cam, cache
+
+
+def test_features_full_resolution_coordinates_and_cache(fountain):
+    paths, feats, cam, cache = fountain
+    f = feats[0]
+    assert 1000 < len(f) <= 8000 and f.descriptors.shape == (len(f), 128)
+    assert f.descriptors.dtype == np.float32
+    assert np.allclose(np.linalg.norm(f.descriptors, axis=1), 1.0, atol=1e-4)  # RootSIFT
+    assert (f.width, f.height) == (3072, 2048) and f.scale == pytest.approx(1000 / 3072, rel=1e-3)
+    assert f.xy[:, 0].max() > 2500 and f.xy[:, 1].max() > 1500 and f.xy.min() > -0.5
+    assert f.colors.shape == (len(f), 3) and f.colors.dtype == np.uint8
+    # the cache answers the rerun, independent of root_sift
+    cp = cache_path(paths[0], cache, FeatureConfig(max_dimension=1000, root_sift=False))
+    assert Path(cp).is_file()
+    t = time.perf_counter()
+    g = extract_features(paths[0], FeatureConfig(max_dimension=1000, root_sift=False), cache_dir=cache)
+    assert time.perf_counter() - t < 0.2
+    assert np.array_equal(g.xy, f.xy) and not np.allclose(g.descriptors, f.descriptors)
+
+
+def test_feature_errors_and_cancel(tmp_path):
+    bad = tmp_path / "bad.jpg"
+    bad.write_bytes(b"\xff\xd8 not really")
+    with pytest.raises(FormatError, match="bad.jpg"):
+        extract_features(bad)
+    with pytest.raises(InputError, match="max_features"):
+        extract_features(bad, FeatureConfig(max_features=0))
+    with pytest.raises(CancelledError):
+        extract_all([bad], progress=CallbackProgress(is_cancelled=lambda: True))
+
+
+def test_match_descriptors_mutual_and_ratio():
+    rng = np.random.default_rng(0)
+    a = rng.normal(size=(300, 32)).astype(np.float32)
+    perm = rng.permutation(300)
+    b = a[perm] + rng.normal(0, 0.01, (300, 32)).astype(np.float32)
+    for method in ("bf", "flann"):
+        m, d = match_descriptors(a, b, MatchConfig(method=method))
+        assert len(m) > 290 and np.all(perm[m[:, 1]] == m[:, 0])
+    # a duplicated descriptor fails the ratio test
+    m, _ = match_descriptors(a[:1], np.vstack([a[:1], a[:1] + 1e-4]))
+    assert len(m) == 0
+    with pytest.raises(InputError, match="ratio"):
+        match_descriptors(a, b, MatchConfig(ratio=1.5))
+
+
+def test_fountain_essential_pose_vs_ground_truth(fountain):
+    paths, feats, cam, _ = fountain
+    pairs = [(i, i + 1) for i in range(10)]
+    res, st = match_pairs(feats, pairs, [cam] * 11)
+    print(
+        f"\nmatching (exact BF, mutual, ratio 0.8): {st['seconds_matching'] / len(pairs):.3f} s/pair, "
+        f"essential + pose: {st['seconds_geometry'] / len(pairs):.3f} s/pair"
+    )
+    for r in res:
+        g = r.geometry
+        assert r.ok and g.model == "essential", (r.i, r.j, g.reason)
+        assert g.n_inliers > 100
+        Ri, Ci = _gt_pose(r.i)
+        Rj, Cj = _gt_pose(r.j)
+        err = _rot_angle_deg(Rj @ Ri.T, g.R)
+        t_gt = Rj @ (Ci - Cj)
+        t_err = np.degrees(np.arccos(np.clip(t_gt @ g.t / np.linalg.norm(t_gt), -1, 1)))
+        print(
+            f"  {r.i:04d}-{r.j:04d}: {r.n_putative} matches, {g.n_inliers} inliers, "
+            f"H ratio {g.h_ratio:.2f}, rot err {err:.3f} deg, t err {t_err:.2f} deg"
+        )
+        assert err < 1.0 and t_err < 3.0
+        assert 2.0 < g.median_angle_deg < 30.0
+
+
+def test_fountain_fundamental_without_k(fountain):
+    paths, feats, cam, _ = fountain
+    res, _ = match_pairs(feats, [(0, 1), (4, 5), (9, 10)])
+    for r in res:
+        g = r.geometry
+        assert r.ok and g.model == "fundamental" and g.R is None and g.n_inliers > 100
+        # the ground-truth epipolar geometry agrees with the inliers
+        Ri, Ci = _gt_pose(r.i)
+        Rj, Cj = _gt_pose(r.j)
+        Rrel, t = Rj @ Ri.T, Rj @ (Ci - Cj)
+        tx = np.array([[0, -t[2], t[1]], [t[2], 0, -t[0]], [-t[1], t[0], 0]])
+        Kinv = np.linalg.inv(cam.K)
+        F = Kinv.T @ tx @ Rrel @ Kinv
+        x1 = np.column_stack([feats[r.i].xy[g.inliers[:, 0]], np.ones(g.n_inliers)])
+        x2 = np.column_stack([feats[r.j].xy[g.inliers[:, 1]], np.ones(g.n_inliers)])
+        l2 = x1 @ F.T
+        dist = np.abs(np.sum(x2 * l2, axis=1)) / np.linalg.norm(l2[:, :2], axis=1)
+        assert np.median(dist) < 3.0  # full-resolution pixels, features from 1000 px
+
+
+def test_two_view_rejects_with_reason():
+    rng = np.random.default_rng(0)
+    xy1 = rng.uniform(0, 1000, (15, 2))
+    r = estimate_two_view(xy1, xy1 + 1.0)
+    assert not r.ok and "too few matches" in r.reason
+    r = estimate_two_view(rng.uniform(0, 1000, (200, 2)), rng.uniform(0, 1000, (200, 2)))
+    assert not r.ok and r.reason
+    with pytest.raises(InputError, match="differ"):
+        estimate_two_view(xy1, xy1[:5])
+    with pytest.raises(InputError, match="method"):
+        TwoViewConfig(method="lmeds").validate()
+
+
+def test_planar_scene_is_flagged():
+    rng = np.random.default_rng(1)
+    cam = Camera(1000, 800, 900.0, 900.0, 499.5, 399.5)
+    X = np.column_stack([rng.uniform(-20, 20, 300), rng.uniform(-15, 15, 300), np.zeros(300)])
+    from truortho.core.geometry import opk_to_matrix, project_points
+
+    R1, R2 = opk_to_matrix(0, 0, 0), opk_to_matrix(2.0, -1.0, 3.0, degrees=True)
+    uv1 = project_points(X, R1, [0, 0, 60.0], cam)
+    uv2 = project_points(X, R2, [12.0, 1.0, 60.0], cam)
+    r = estimate_two_view(uv1, uv2, cam, cam)
+    assert r.ok and r.configuration == "planar_or_panoramic" and r.h_ratio > 0.8
+
+
+def test_brighton_gps_pairs(tmp_path):
+    paths = sorted((DATA / "brighton/images").glob("*.JPG"))
+    t = time.perf_counter()
+    sel = select_pairs(paths, config=PairConfig(strategy="gps"))
+    print(
+        f"\nGPS pairs: {sel.n_pairs} of {sel.n_exhaustive} in {time.perf_counter() - t:.2f} s, "
+        f"ground from {sel.details['ground_source']}, H {sel.details['median_height_m']:.1f} m"
+    )
+    assert sel.strategy == "gps" and sel.n_pairs < sel.n_exhaustive
+    assert sel.details["ground_source"] == "relative_altitude"
+    assert 35 < sel.details["median_height_m"] < 45
+    # consecutive pairs that really overlap (verified by low-resolution matching) are selected
+    feats, _ = extract_all(paths, FeatureConfig(max_dimension=640, max_features=1500), cache_dir=tmp_path)
+    consecutive = [(i, i + 1) for i in range(len(paths) - 1)]
+    res, st = match_pairs(feats, consecutive, twoview_config=TwoViewConfig(min_inliers=20))
+    verified = {(r.i, r.j) for r in res if r.ok}
+    assert len(verified) >= 12
+    assert verified <= {tuple(p) for p in sel.pairs.tolist()}
+    # auto: 18 images -> exhaustive
+    assert select_pairs(paths).strategy == "exhaustive"
+
+
+def test_copr_retrieval_pairs(tmp_path):
+    paths = sorted((DATA / "copr/images").glob("*.jpg"))
+    cfg = PairConfig(retrieval_k=8, retrieval_max_dimension=480, retrieval_features=400)
+    sel = select_pairs(paths, config=cfg, cache_dir=tmp_path)
+    print(
+        f"\nretrieval: {sel.n_pairs} of {sel.n_exhaustive} pairs, "
+        f"features {sel.details['seconds_features']:.1f} s,"
+        f" VLAD {sel.details['seconds'] - sel.details['seconds_features']:.2f} s"
+    )
+    assert sel.strategy == "retrieval" and sel.n_pairs < 0.3 * sel.n_exhaustive
+    feats, _ = extract_all(paths, FeatureConfig(max_dimension=480, max_features=400), cache_dir=tmp_path)
+    res, st = match_pairs(feats, exhaustive_pairs(len(paths)), twoview_config=TwoViewConfig(min_inliers=20))
+    print(f"exhaustive low-res verification: {st['seconds']:.1f} s for {st['pairs']} pairs")
+    strong = {(r.i, r.j) for r in res if r.ok and r.geometry.n_inliers >= 60}
+    S = {tuple(p) for p in sel.pairs.tolist()}
+    recall = len(strong & S) / max(len(strong), 1)
+    print(f"recall of strong pairs: {recall:.2f} ({len(strong)} strong)")
+    assert len(strong) > 40 and recall > 0.85
+
+
+def test_keypoint_positions_have_no_half_pixel_bias(tmp_path):
+    """A feature at x in an image is at W - 1 - x in its 180° rotation (pixel-centre convention)."""
+    import cv2
+
+    from truortho.core.sfm.features import FeatureConfig, extract_features
+
+    rng = np.random.default_rng(0)
+    img = cv2.GaussianBlur(rng.integers(0, 255, (240, 320)).astype(np.uint8), (0, 0), 2.0)
+    img = cv2.normalize(img, None, 0, 255, cv2.NORM_MINMAX)
+    cv2.imwrite(str(tmp_path / "a.png"), img)
+    cv2.imwrite(str(tmp_path / "b.png"), img[::-1, ::-1].copy())
+    cfg = FeatureConfig(max_dimension=320, max_features=2000, root_sift=False)
+    fa, fb = extract_features(tmp_path / "a.png", cfg), extract_features(tmp_path / "b.png", cfg)
+    m = cv2.BFMatcher(crossCheck=True).match(fa.descriptors, fb.descriptors)
+    pa = fa.xy[[x.queryIdx for x in m]]
+    pb = fb.xy[[x.trainIdx for x in m]]
+    s = pa + pb - [319, 239]
+    ok = np.all(np.abs(s) < 1.0, axis=1)
+    assert ok.sum() > 50
+    np.testing.assert_allclose(np.median(s[ok], axis=0) / 2, [0.0, 0.0], atol=0.03)
