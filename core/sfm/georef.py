@@ -124,6 +124,47 @@ def triangulate_gcps(block: Block, gcps: list[GCP]):
     return xyz, n_views, res.max_error
 
 
+def reject_gcp_outliers(
+    block: Block, gcps: list[GCP], max_error_px: float = 5.0
+) -> tuple[list[GCP], list[str]]:
+    """Drop the one image measurement per GCP that makes its rays miss each other.
+
+    A GCP with at least three measurements on the block whose triangulation
+    fails or leaves a reprojection error above ``max_error_px`` is
+    triangulated again without each measurement in turn; when exactly the
+    removal of one measurement brings every error below the threshold, that
+    measurement is dropped (a mis-identified target or a typo in the list).
+    Returns the (copied) GCPs and a warning per dropped measurement.
+    """
+    out, msgs = [], []
+    names = set(block.image_names)
+    for g in gcps:
+        obs = [o for o in g.observations if o[0] in names]
+        if len(obs) < 3:
+            out.append(g)
+            continue
+        xyz, _, err = triangulate_gcps(block, [g])
+        if np.isfinite(xyz[0, 0]) and err[0] <= max_error_px:
+            out.append(g)
+            continue
+        fixes = []
+        for k in range(len(obs)):
+            trial = GCP(g.name, g.xyz, g.role, g.sigma, [o for j, o in enumerate(obs) if j != k])
+            xyz_k, _, err_k = triangulate_gcps(block, [trial])
+            if np.isfinite(xyz_k[0, 0]) and err_k[0] <= max_error_px:
+                fixes.append((err_k[0], k, trial))
+        if len(fixes) == 1 or (len(fixes) > 1 and sorted(f[0] for f in fixes)[1] > max_error_px / 2):
+            e, k, trial = min(fixes, key=lambda f: f[0])
+            msgs.append(
+                f"GCP {g.name}: measurement on {obs[k][0]} rejected (the other rays meet within {e:.2f} px, "
+                "this one does not)"
+            )
+            out.append(trial)
+        else:
+            out.append(g)
+    return out, msgs
+
+
 def _rmse(d: np.ndarray) -> dict:
     if len(d) == 0:
         return {}
@@ -160,6 +201,8 @@ def georeference(
     """
     cfg = config or GeorefConfig()
     result = GeorefResult(method="none")
+    gcps, rejected = reject_gcp_outliers(block, gcps)
+    result.warnings += rejected
     control = [g for g in gcps if g.role == "gcp"]
     checks = [g for g in gcps if g.role == "check"]
     _, _, _, unknown = _gcp_tracks(block, gcps)
@@ -173,9 +216,14 @@ def georeference(
     )
     usable = np.isfinite(ctrl_xyz[:, 0]) if len(control) else np.zeros(0, bool)
     for g, ok, nv in zip(control, usable, ctrl_views, strict=True):
-        if not ok:
+        if not ok and nv < 2:
             result.warnings.append(
                 f"GCP {g.name}: {int(nv)} observation(s) on oriented images; at least 2 are needed, not used"
+            )
+        elif not ok:
+            result.warnings.append(
+                f"GCP {g.name}: its {int(nv)} image measurements do not intersect (triangulation failed); "
+                "check them; not used"
             )
     target = np.array([g.xyz for g in control]).reshape(-1, 3) - offset
     sim = None

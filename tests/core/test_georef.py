@@ -76,3 +76,20 @@ def test_unusable_gcps_are_reported(block_and_truth):
     assert validate_gcps([GCP("x", OFFSET, "gcp")], set(names)) == ["GCP x has no image observations"]
     with pytest.raises(InputError, match="unknown images"):
         validate_gcps([GCP("y", OFFSET, "gcp", None, [("nope.jpg", 1.0, 2.0)])], set(names))
+
+
+def test_wrong_gcp_measurement_is_rejected(block_and_truth):
+    rec, (tr, im, xy), names, prior, Rs, Cs, gcps = block_and_truth
+    block, _ = block_from_reconstruction(rec, tr, im, xy, names, [prior], np.zeros(len(names), int))
+    g = next(g for g in gcps if g.role == "gcp" and len(g.observations) >= 4)
+    bad_name, x, y = g.observations[1]
+    g_bad = GCP(
+        g.name,
+        g.xyz,
+        "gcp",
+        None,
+        [*g.observations[:1], (bad_name, x + 150.0, y - 90.0), *g.observations[2:]],
+    )
+    res = georeference(block, [g_bad if h is g else h for h in gcps], OFFSET)
+    assert any(f"measurement on {bad_name} rejected" in w for w in res.warnings), res.warnings
+    assert res.check_rmse["xy"] < 0.12
