@@ -151,12 +151,10 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
 
     def _image_paths(self, parameters, context) -> list[str]:
         folder = self.parameterAsFile(parameters, self.IMAGES, context)
-        files = (
-            self.parameterAsFileList(parameters, self.IMAGE_FILES, context)
-            if hasattr(self, "parameterAsFileList")
-            else self.parameterAsLayerList(parameters, self.IMAGE_FILES, context)
-        )
-        files = [str(f) for f in (files or [])]
+        raw = parameters.get(self.IMAGE_FILES) or []
+        if isinstance(raw, str):
+            raw = [raw]
+        files = [f.source() if hasattr(f, "source") else str(f) for f in raw]
         if folder and files:
             raise QgsProcessingException(tr("Give either IMAGES (a folder) or IMAGE_FILES, not both"))
         if folder:
