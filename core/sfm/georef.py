@@ -32,7 +32,7 @@ from ..geometry.camera import Camera, undistort_points
 from ..orientation import GCP
 from ..progress import Progress
 from .bundle import BundleConfig, BundleProblem, bundle_adjust
-from .similarity import estimate_similarity
+from .similarity import Similarity, estimate_similarity
 from .triangulation import triangulate_tracks
 
 
@@ -165,6 +165,62 @@ def reject_gcp_outliers(
     return out, msgs
 
 
+def _near_collinear(xy: np.ndarray, ratio: float = 0.2) -> bool:
+    """True when plan points spread along one line (second singular value < ratio x first)."""
+    d = xy - xy.mean(axis=0)
+    sv = np.linalg.svd(d, compute_uv=False)
+    return bool(len(xy) < 3 or sv[1] < ratio * max(sv[0], 1e-12))
+
+
+def _level_rotation(block: Block) -> np.ndarray:
+    """Rotation that makes the tie points' best-fitting plane horizontal, cameras above it."""
+    pts = block.points[np.all(np.isfinite(block.points), axis=1)]
+    if len(pts) < 10:
+        raise GeometryError("too few tie points to level the block")
+    c = np.median(pts, axis=0)
+    _, _, vt = np.linalg.svd(pts - c, full_matrices=False)
+    n = vt[2]
+    if np.dot(np.median(block.centers, axis=0) - c, n) < 0:
+        n = -n
+    z = np.array([0.0, 0.0, 1.0])
+    v = np.cross(n, z)
+    s, cth = np.linalg.norm(v), float(np.dot(n, z))
+    if s < 1e-12:
+        return np.eye(3) if cth > 0 else np.diag([1.0, -1.0, -1.0])
+    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]]) / s
+    ang = np.arctan2(s, cth)
+    return np.eye(3) + np.sin(ang) * K + (1 - np.cos(ang)) * (K @ K)
+
+
+def _levelled_similarity(block: Block, src: np.ndarray, dst: np.ndarray, sigma: np.ndarray) -> Similarity:
+    """Similarity for weak control: level on the tie points, then fit scale, heading and shift in plan.
+
+    Heights: the shift in Z is the weighted mean height difference of the
+    control points (weights ``1 / sigma_z^2``), so plan-only control with
+    arbitrary heights still places the block at the heights it gives.
+    """
+    L = _level_rotation(block)
+    a = src @ L.T
+    b = dst
+    # 2-D similarity in plan (complex least squares)
+    za = a[:, 0] + 1j * a[:, 1]
+    zb = b[:, 0] + 1j * b[:, 1]
+    ma, mb = za.mean(), zb.mean()
+    da, db = za - ma, zb - mb
+    denom = float(np.sum(np.abs(da) ** 2))
+    if denom <= 1e-18:
+        raise GeometryError("control points coincide in plan")
+    q = np.sum(np.conj(da) * db) / denom  # scale * exp(i heading)
+    scale = float(abs(q))
+    th = float(np.angle(q))
+    Rz = np.array([[np.cos(th), -np.sin(th), 0.0], [np.sin(th), np.cos(th), 0.0], [0.0, 0.0, 1.0]])
+    R = Rz @ L
+    w = 1.0 / sigma[:, 2] ** 2
+    t_xy = mb - q * ma
+    tz = float(np.sum(w * (b[:, 2] - scale * a[:, 2])) / np.sum(w))
+    return Similarity(scale, R, np.array([t_xy.real, t_xy.imag, tz]))
+
+
 def _rmse(d: np.ndarray) -> dict:
     if len(d) == 0:
         return {}
@@ -227,9 +283,21 @@ def georeference(
             )
     target = np.array([g.xyz for g in control]).reshape(-1, 3) - offset
     sim = None
-    if usable.sum() >= 3:
+    n_use = int(usable.sum())
+    if n_use >= 2:
+        sig = np.array(
+            [g.sigma if g.sigma is not None else [cfg.gcp_sigma_xy] * 2 + [cfg.gcp_sigma_z] for g in control]
+        ).reshape(-1, 3)[usable]
+        weak = n_use < 4 or _near_collinear(target[usable, :2]) or bool(np.all(sig[:, 2] > 10 * sig[:, 0]))
         try:
-            sim = estimate_similarity(ctrl_xyz[usable], target[usable])
+            if weak:
+                sim = _levelled_similarity(block, ctrl_xyz[usable], target[usable], sig)
+                result.warnings.append(
+                    "weak control geometry (fewer than 4 points, nearly collinear, or plan-only heights): "
+                    "the block was levelled on its tie points before fitting the control in plan"
+                )
+            else:
+                sim = estimate_similarity(ctrl_xyz[usable], target[usable])
             result.method = "gcp"
         except GeometryError as err:
             result.warnings.append(f"control points unusable for the datum: {err}")
@@ -244,7 +312,7 @@ def georeference(
     if sim is None:
         if gcps:
             result.warnings.append(
-                "fewer than 3 usable control points: the block stays in an arbitrary frame"
+                "fewer than 2 usable control points: the block stays in an arbitrary frame"
             )
         return result
     block.transform(sim)

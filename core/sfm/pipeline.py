@@ -295,6 +295,30 @@ def orient_images(
     elif camera_file:
         inc.refine_focal_early = False
     rec = reconstruct(tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, steps[4])
+    missing = np.flatnonzero(~rec.registered)
+    if len(missing) and sel.strategy != "exhaustive" and rec.registered.sum() >= 2:
+        # second chance: match the images left out against every image not paired with them yet
+        tried = {(int(a), int(b)) for a, b in sel.pairs}
+        extra = sorted(
+            {(min(int(m), j), max(int(m), j)) for m in missing for j in range(len(paths)) if j != m} - tried
+        )
+        if extra:
+            check(prog)
+            prog.update(
+                0.85, f"matching {len(missing)} unregistered image(s) against all others ({len(extra)} pairs)"
+            )
+            more, _ = match_pairs(features, np.array(extra), per_image_cams)
+            results = results + more
+            n_verified = sum(r.ok for r in results)
+            tracks2 = tracks_from_pairs(features, results, cell)
+            rec2 = reconstruct(tracks2.track, tracks2.image, tracks2.xy, image_camera, cams, inc, None)
+            if rec2.registered.sum() > rec.registered.sum():
+                rec, tracks = rec2, tracks2
+            stats_extra = {"second_pass_pairs": len(extra), "registered_after": int(rec.registered.sum())}
+            warnings.append(
+                f"second matching pass for {len(missing)} image(s): {len(extra)} more pairs, "
+                f"{stats_extra['registered_after']} images registered"
+            )
     times["reconstruction"] = time.perf_counter() - t
     n_reg = int(rec.registered.sum())
     if n_reg < 2:

@@ -93,3 +93,14 @@ def test_wrong_gcp_measurement_is_rejected(block_and_truth):
     res = georeference(block, [g_bad if h is g else h for h in gcps], OFFSET)
     assert any(f"measurement on {bad_name} rejected" in w for w in res.warnings), res.warnings
     assert res.check_rmse["xy"] < 0.12
+
+
+def test_plan_only_control_is_levelled(block_and_truth):
+    """Plan-only control (huge sigma_z, e.g. heights all 0 in the file) still gives plan accuracy."""
+    rec, (tr, im, xy), names, prior, Rs, Cs, gcps = block_and_truth
+    block, _ = block_from_reconstruction(rec, tr, im, xy, names, [prior], np.zeros(len(names), int))
+    plan = [GCP(g.name, g.xyz, g.role, [0.02, 0.02, 50.0], g.observations) for g in gcps]
+    res = georeference(block, plan, OFFSET)
+    assert res.method == "gcp" and any("levelled" in w for w in res.warnings)
+    assert res.check_rmse["xy"] < 0.12, res.check_rmse
+    assert np.all(block.centers[:, 2] > 100)  # cameras above the ground, not flipped
