@@ -53,8 +53,10 @@ class OrientConfig:
     working_size: int = 2000
     #: Features per image.
     max_features: int = 8000
-    #: Self-calibrate f, cx, cy, k1, k2, p1, p2 (else the interior orientation is held).
+    #: Self-calibrate the interior orientation (else it is held).
     self_calibration: bool = True
+    #: Intrinsics estimated by self-calibration (subset of f, cx, cy, k1, k2, k3, p1, p2).
+    refine_intrinsics: tuple[str, ...] = ALL_INTRINSICS
     #: Tie-point decimation grid cell, pixels at full resolution (None: max(w, h) / 50).
     decimation_cell_px: float | None = None
     #: Pair selection strategy: auto, exhaustive, gps, retrieval.
@@ -289,6 +291,7 @@ def orient_images(
 
     t = time.perf_counter()
     inc = cfg.incremental
+    inc.refine_intrinsics = tuple(cfg.refine_intrinsics)
     if not cfg.self_calibration:
         inc.refine_intrinsics = ()
         inc.refine_focal_early = False
@@ -331,7 +334,7 @@ def orient_images(
         rec, tracks.track, tracks.image, tracks.xy, names, cams, image_camera
     )
     gcfg = cfg.georef
-    gcfg.refine_intrinsics = ALL_INTRINSICS if cfg.self_calibration else ()
+    gcfg.refine_intrinsics = tuple(cfg.refine_intrinsics) if cfg.self_calibration else ()
     gps_world, crs = _gps_local(exifs, crs, warnings) if not gcps else (None, crs)
     offset = np.zeros(3)
     if gcps:
