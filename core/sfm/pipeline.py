@@ -55,7 +55,8 @@ class OrientConfig:
     max_features: int = 8000
     #: Self-calibrate the interior orientation (else it is held).
     self_calibration: bool = True
-    #: Intrinsics estimated by self-calibration (subset of f, cx, cy, k1, k2, k3, p1, p2).
+    #: Intrinsics estimated by self-calibration (subset of f, cx, cy, k1, k2, k3, p1, p2); with a
+    #: given interior orientation file and this default, only ``f`` is refined (the file is a calibration).
     refine_intrinsics: tuple[str, ...] = ALL_INTRINSICS
     #: Tie-point decimation grid cell, pixels at full resolution (None: max(w, h) / 50).
     decimation_cell_px: float | None = None
@@ -291,7 +292,11 @@ def orient_images(
 
     t = time.perf_counter()
     inc = cfg.incremental
-    inc.refine_intrinsics = tuple(cfg.refine_intrinsics)
+    refine = tuple(cfg.refine_intrinsics)
+    if camera_file and refine == ALL_INTRINSICS:
+        # a given interior orientation is taken as calibrated: only the focal length follows the block
+        refine = ("f",)
+    inc.refine_intrinsics = refine
     if not cfg.self_calibration:
         inc.refine_intrinsics = ()
         inc.refine_focal_early = False
@@ -334,7 +339,7 @@ def orient_images(
         rec, tracks.track, tracks.image, tracks.xy, names, cams, image_camera
     )
     gcfg = cfg.georef
-    gcfg.refine_intrinsics = tuple(cfg.refine_intrinsics) if cfg.self_calibration else ()
+    gcfg.refine_intrinsics = refine if cfg.self_calibration else ()
     gps_world, crs = _gps_local(exifs, crs, warnings) if not gcps else (None, crs)
     offset = np.zeros(3)
     if gcps:
