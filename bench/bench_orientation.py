@@ -13,7 +13,8 @@ Datasets (under ``$TRUORTHO_BENCH_DATA``, default ``/work/shared/data``):
   CAMERA file, pycolmap one PINHOLE camera with the same K (principal point + 0.5 px for
   COLMAP's pixel-corner convention). Both engines keep their default refinement of the intrinsics;
 * ``copr``: 41 drone images; TruOrtho with the GCPs of ``gcp_list.txt`` (every second target, by
-  name, a check point; plan-only control with sigma_xy = 3 m (averaged hand-held GNSS) and sigma_z = 50 m (heights are 0),
+  name, a check point; plan-only control with sigma_xy = 3 m (averaged hand-held GNSS) and
+  sigma_z = 50 m (heights are 0),
   pycolmap without GCPs (one SIMPLE_RADIAL camera): registration, time and memory only.
 
 For fountain-P11 the estimated camera centres are aligned to the ground truth
