@@ -66,6 +66,19 @@ def _solve3(A, b):
     return x, det
 
 
+@njit
+def _to_camera(Rs, Cs, i, X):
+    """Camera coordinates ``R_i (X - C_i)`` of a point."""
+    p = np.empty(3)
+    for r in range(3):
+        p[r] = (
+            Rs[i, r, 0] * (X[0] - Cs[i, 0])
+            + Rs[i, r, 1] * (X[1] - Cs[i, 1])
+            + Rs[i, r, 2] * (X[2] - Cs[i, 2])
+        )
+    return p
+
+
 @pjit
 def _triangulate(offsets, img, xy, Rs, Cs, scale, iterations, out, angle, max_err, ok):
     n_tracks = offsets.shape[0] - 1
@@ -122,13 +135,7 @@ def _triangulate(offsets, img, xy, Rs, Cs, scale, iterations, out, angle, max_er
             behind = False
             for k in range(m):
                 i = img[s + k]
-                p = np.empty(3)
-                for r in range(3):
-                    p[r] = (
-                        Rs[i, r, 0] * (X[0] - Cs[i, 0])
-                        + Rs[i, r, 1] * (X[1] - Cs[i, 1])
-                        + Rs[i, r, 2] * (X[2] - Cs[i, 2])
-                    )
+                p = _to_camera(Rs, Cs, i, X)
                 if p[2] <= 0:
                     behind = True
                     break
@@ -155,13 +162,7 @@ def _triangulate(offsets, img, xy, Rs, Cs, scale, iterations, out, angle, max_er
         good = True
         for k in range(m):
             i = img[s + k]
-            p = np.empty(3)
-            for r in range(3):
-                p[r] = (
-                    Rs[i, r, 0] * (X[0] - Cs[i, 0])
-                    + Rs[i, r, 1] * (X[1] - Cs[i, 1])
-                    + Rs[i, r, 2] * (X[2] - Cs[i, 2])
-                )
+            p = _to_camera(Rs, Cs, i, X)
             if p[2] <= 0:
                 good = False
                 break
