@@ -1,0 +1,471 @@
+"""Raster and point-cloud files, always written atomically.
+
+Every product is first written to a temporary file beside its destination
+(``.<name>.tmp<pid>...``) and renamed into place only when complete, so a
+failure or a cancel never leaves a half-written output (and never destroys an
+older file of the same name before the new one is ready).
+
+* :class:`RasterWriter`: a GeoTIFF written window by window (tiles), with CRS,
+  nodata, band descriptions, optional internal overviews and an optional
+  Cloud-Optimized GeoTIFF layout (GDAL's COG driver) on completion.
+* :func:`write_raster`: a whole array at once (through :class:`RasterWriter`).
+* :func:`read_raster`, :func:`raster_grid`, :func:`read_onto_grid`: read a raster
+  as stored, or resampled/reprojected onto a :class:`~.grid.RasterGrid`.
+* :func:`write_point_cloud`: LAS 1.4 / LAZ with RGB, extra dimensions and the
+  CRS as WKT.
+
+GDAL-linked packages come from the same distribution as QGIS (README,
+"Dependency policy"); rasterio is imported lazily.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import CRSError, FormatError, InputError, MissingFileError
+from .grid import RasterGrid
+
+RASTER_EXTENSIONS = (".tif", ".tiff")
+POINT_CLOUD_EXTENSIONS = (".las", ".laz")
+
+
+def temporary_path(path: str | os.PathLike) -> Path:
+    """A temporary sibling of ``path`` with the same suffix (hidden, pid-tagged)."""
+    p = Path(path)
+    return p.with_name(f".{p.stem}.tmp{os.getpid()}{p.suffix}")
+
+
+@contextlib.contextmanager
+def atomic_output(path: str | os.PathLike):
+    """Yield a temporary path; rename it onto ``path`` only if the block succeeds.
+
+    Auxiliary files GDAL may create beside the temporary file (``.aux.xml``,
+    ``.ovr``) are removed as well.
+    """
+    dest = Path(path)
+    if dest.parent and not dest.parent.exists():
+        dest.parent.mkdir(parents=True, exist_ok=True)
+    tmp = temporary_path(dest)
+    try:
+        yield tmp
+        os.replace(tmp, dest)
+    finally:
+        for p in (tmp, Path(str(tmp) + ".aux.xml"), Path(str(tmp) + ".ovr")):
+            with contextlib.suppress(FileNotFoundError):
+                p.unlink()
+
+
+def _check_raster_path(path, what: str = "output") -> Path:
+    p = Path(os.fspath(path))
+    if p.suffix.lower() not in RASTER_EXTENSIONS:
+        raise InputError(f"{what} {str(p)!r}: expected a GeoTIFF file name ending in .tif or .tiff")
+    return p
+
+
+def _crs_object(crs):
+    if crs is None:
+        return None
+    from rasterio.crs import CRS
+    from rasterio.errors import CRSError as _RioCRSError
+
+    try:
+        return CRS.from_user_input(crs)
+    except (_RioCRSError, ValueError, TypeError) as exc:
+        raise CRSError(f"cannot use the CRS {str(crs)[:80]!r} for a raster: {exc}") from None
+
+
+class RasterWriter:
+    """A GeoTIFF written by windows, renamed into place on success.
+
+    Use as a context manager::
+
+        with RasterWriter(path, grid, bands=1, dtype="float32", nodata=-9999) as w:
+            for tile in grid.tiles(512):
+                w.write(values[tile.inner_slices], tile.core)
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.tif`` destination.
+    grid : RasterGrid
+        Georeferencing (CRS from ``grid.crs``).
+    bands : int
+    dtype : numpy dtype name
+    nodata : number or None
+    descriptions : sequence of str, optional
+        One description per band.
+    photometric : str, optional
+        ``"RGB"`` or ``"MINISBLACK"``; RGB(A) is set automatically for 3-4 uint8 bands.
+    alpha : bool
+        The last band is an alpha band (``ExtraSamples = unassociated alpha``).
+    overviews : bool
+        Build internal overviews (average, or nearest for integer classes when
+        ``overview_resampling="nearest"``) when closing.
+    cog : bool
+        Rewrite as a Cloud-Optimized GeoTIFF (implies overviews).
+    compress : str
+        ``"deflate"`` (default), ``"lzw"``, ``"zstd"`` or ``"none"``.
+    block : int
+        Internal tile size (a multiple of 16).
+    """
+
+    def __init__(
+        self,
+        path,
+        grid: RasterGrid,
+        bands: int = 1,
+        dtype="float32",
+        nodata=None,
+        descriptions: Sequence[str] | None = None,
+        photometric: str | None = None,
+        alpha: bool = False,
+        overviews: bool = False,
+        overview_resampling: str = "average",
+        cog: bool = False,
+        compress: str = "deflate",
+        block: int = 256,
+    ) -> None:
+        self.path = _check_raster_path(path)
+        if not isinstance(grid, RasterGrid):
+            raise InputError(f"{self.path}: expected a RasterGrid, got {type(grid).__name__}")
+        if not isinstance(bands, int) or bands < 1:
+            raise InputError(f"{self.path}: band count must be a positive integer, got {bands!r}")
+        if block % 16 or block < 16:
+            raise InputError(f"{self.path}: block size must be a positive multiple of 16, got {block}")
+        self.grid = grid
+        self.bands = bands
+        self.dtype = np.dtype(dtype)
+        self.nodata = nodata
+        self.descriptions = list(descriptions) if descriptions else None
+        if self.descriptions is not None and len(self.descriptions) != bands:
+            raise InputError(f"{self.path}: {len(self.descriptions)} band descriptions for {bands} bands")
+        self.overviews = overviews or cog
+        self.overview_resampling = overview_resampling
+        self.cog = cog
+        self.compress = compress
+        self.profile = {
+            "driver": "GTiff",
+            "width": grid.cols,
+            "height": grid.rows,
+            "count": bands,
+            "dtype": self.dtype.name,
+            "crs": _crs_object(grid.crs),
+            "transform": grid.transform,
+            "nodata": nodata,
+            "tiled": True,
+            "blockxsize": block,
+            "blockysize": block,
+            "BIGTIFF": "IF_SAFER",
+        }
+        if compress and compress.lower() != "none":
+            self.profile["compress"] = compress
+            if compress.lower() in ("deflate", "lzw", "zstd"):
+                self.profile["predictor"] = 3 if self.dtype.kind == "f" else 2
+        if photometric is None and self.dtype == np.uint8 and bands in (3, 4):
+            photometric = "RGB"
+        if photometric:
+            self.profile["photometric"] = photometric
+        self.alpha = alpha
+        self._tmp: Path | None = None
+        self._ds: Any = None
+
+    # ------------------------------------------------------------ context
+    def __enter__(self) -> RasterWriter:
+        import rasterio
+
+        self._tmp = temporary_path(self.path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        try:
+            self._ds = rasterio.open(self._tmp, "w", **self.profile)
+        except Exception as exc:
+            self._cleanup()
+            raise FormatError(self.path, f"cannot create the raster ({exc})") from None
+        if self.descriptions:
+            for i, d in enumerate(self.descriptions, start=1):
+                self._ds.set_band_description(i, d)
+        if self.alpha:
+            from rasterio.enums import ColorInterp
+
+            ci = [ColorInterp.red, ColorInterp.green, ColorInterp.blue][: self.bands - 1]
+            if len(ci) < self.bands - 1:
+                ci = [ColorInterp.gray] * (self.bands - 1)
+            self._ds.colorinterp = ci + [ColorInterp.alpha]
+        return self
+
+    def write(self, data: np.ndarray, window: tuple[int, int, int, int] | None = None) -> None:
+        """Write ``data`` ((rows, cols) or (bands, rows, cols)) at ``window = (row0, col0, rows, cols)``."""
+        if self._ds is None:
+            raise InputError(f"{self.path}: RasterWriter.write outside its 'with' block")
+        from rasterio.windows import Window
+
+        a = np.asarray(data)
+        if a.ndim == 2:
+            a = a[None]
+        if a.ndim != 3 or a.shape[0] != self.bands:
+            raise InputError(
+                f"{self.path}: expected {self.bands} band(s) of 2-D data, got shape {np.shape(data)}"
+            )
+        if window is None:
+            window = (0, 0, self.grid.rows, self.grid.cols)
+        r0, c0, nr, nc = (int(v) for v in window)
+        if a.shape[1:] != (nr, nc):
+            raise InputError(f"{self.path}: data of shape {a.shape[1:]} for a window of {nr} x {nc} cells")
+        if r0 < 0 or c0 < 0 or r0 + nr > self.grid.rows or c0 + nc > self.grid.cols:
+            raise InputError(
+                f"{self.path}: window {window} outside the {self.grid.rows} x {self.grid.cols} grid"
+            )
+        self._ds.write(a.astype(self.dtype, copy=False), window=Window(c0, r0, nc, nr))
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        ds, self._ds = self._ds, None
+        try:
+            if exc_type is None and ds is not None and self._tmp is not None:
+                if self.overviews:
+                    self._build_overviews(ds)
+                ds.close()
+                if self.cog:
+                    self._to_cog()
+                os.replace(self._tmp, self.path)
+            elif ds is not None:
+                ds.close()
+        finally:
+            self._cleanup()
+
+    # ------------------------------------------------------------ helpers
+    def _build_overviews(self, ds) -> None:
+        from rasterio.enums import Resampling
+
+        factors = []
+        f = 2
+        while max(self.grid.rows, self.grid.cols) / f >= 256:
+            factors.append(f)
+            f *= 2
+        if factors:
+            ds.build_overviews(factors, getattr(Resampling, self.overview_resampling))
+            ds.update_tags(ns="rio_overview", resampling=self.overview_resampling)
+
+    def _to_cog(self) -> None:
+        from rasterio.shutil import copy as rio_copy
+
+        assert self._tmp is not None
+        cog_tmp = self._tmp.with_name(self._tmp.stem + ".cog" + self._tmp.suffix)
+        opts = {
+            "compress": self.profile.get("compress", "none").upper(),
+            "BIGTIFF": "IF_SAFER",
+            "blocksize": self.profile["blockxsize"],
+            "overview_resampling": self.overview_resampling.upper(),
+        }
+        if "predictor" in self.profile:
+            opts["predictor"] = "YES"
+        try:
+            rio_copy(self._tmp, cog_tmp, driver="COG", **opts)
+            os.replace(cog_tmp, self._tmp)
+        finally:
+            with contextlib.suppress(FileNotFoundError):
+                cog_tmp.unlink()
+
+    def _cleanup(self) -> None:
+        if self._tmp is not None:
+            for p in (self._tmp, Path(str(self._tmp) + ".aux.xml"), Path(str(self._tmp) + ".ovr")):
+                with contextlib.suppress(FileNotFoundError):
+                    p.unlink()
+
+
+def write_raster(path, data: np.ndarray, grid: RasterGrid, nodata=None, **options) -> Path:
+    """Write a whole raster ((rows, cols) or (bands, rows, cols)) atomically.
+
+    ``options`` are those of :class:`RasterWriter`.
+    """
+    a = np.asarray(data)
+    bands = 1 if a.ndim == 2 else a.shape[0]
+    if a.shape[-2:] != grid.shape:
+        raise InputError(f"{path}: data of shape {a.shape[-2:]} for a grid of {grid.shape}")
+    options.setdefault("dtype", a.dtype)
+    with RasterWriter(path, grid, bands=bands, nodata=nodata, **options) as w:
+        w.write(a)
+    return Path(path)
+
+
+# ------------------------------------------------------------------ reading
+
+
+def _open(path):
+    import rasterio
+
+    p = os.fspath(path)
+    if not os.path.isfile(p):
+        raise MissingFileError(p, "raster file not found")
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", rasterio.errors.NotGeoreferencedWarning)
+            return rasterio.open(p)
+    except Exception as exc:
+        raise FormatError(p, f"not a readable raster ({exc})") from None
+
+
+def raster_grid(path, require_crs: bool = True) -> RasterGrid:
+    """The :class:`RasterGrid` of a north-up raster file (CRS as WKT or ``AUTH:CODE``)."""
+    with _open(path) as ds:
+        crs = ds.crs
+        if crs is None and require_crs:
+            raise CRSError(f"{path}: the raster has no CRS; assign one (e.g. with gdal_edit.py -a_srs)")
+        text = None
+        if crs is not None:
+            auth = crs.to_authority()
+            text = f"{auth[0]}:{auth[1]}" if auth and crs.to_epsg() is not None else crs.to_wkt()
+        try:
+            return RasterGrid.from_geotransform(ds.transform.to_gdal(), ds.height, ds.width, text)
+        except InputError as exc:
+            raise InputError(f"{path}: {exc}") from None
+
+
+def read_raster(
+    path, band: int | None = 1, window: tuple[int, int, int, int] | None = None, masked_to_nan: bool = True
+):
+    """Read a raster as stored.
+
+    Parameters
+    ----------
+    band : int or None
+        1-based band, or None for all bands ((bands, rows, cols)).
+    window : (row0, col0, rows, cols), optional
+    masked_to_nan : bool
+        For float output: nodata cells become NaN.
+
+    Returns
+    -------
+    (data, grid, nodata)
+        ``grid`` is the grid of the window read; ``nodata`` the file's value.
+    """
+    from rasterio.windows import Window
+
+    grid = raster_grid(path, require_crs=False)
+    with _open(path) as ds:
+        if band is not None and not 1 <= band <= ds.count:
+            raise InputError(f"{path}: band {band} does not exist (the raster has {ds.count} band(s))")
+        win = None
+        if window is not None:
+            r0, c0, nr, nc = window
+            win = Window(c0, r0, nc, nr)
+            grid = grid.window(r0, c0, nr, nc)
+        data = ds.read(band, window=win) if band is not None else ds.read(window=win)
+        nodata = ds.nodata
+    if masked_to_nan and data.dtype.kind == "f" and nodata is not None and not np.isnan(nodata):
+        data = np.where(data == nodata, np.float32(np.nan), data).astype(data.dtype)
+    return data, grid, nodata
+
+
+def read_onto_grid(
+    path, grid: RasterGrid, band: int = 1, resampling: str = "bilinear", dtype="float32"
+) -> np.ndarray:
+    """Resample (and reproject when the CRSs differ) one band onto ``grid``.
+
+    Cells outside the raster or on its nodata become NaN (float output).
+
+    Raises
+    ------
+    CRSError
+        The raster or the grid has no CRS, or no transformation exists between them.
+    """
+    from rasterio.enums import Resampling
+    from rasterio.warp import reproject
+
+    src_grid = raster_grid(path, require_crs=True)
+    if grid.crs is None:
+        raise CRSError("the target grid has no CRS")
+    dst = np.full(grid.shape, np.nan, dtype=dtype)
+    with _open(path) as ds:
+        if not 1 <= band <= ds.count:
+            raise InputError(f"{path}: band {band} does not exist (the raster has {ds.count} band(s))")
+        try:
+            reproject(
+                source=ds.read(band).astype(dtype),
+                destination=dst,
+                src_transform=ds.transform,
+                src_crs=ds.crs,
+                src_nodata=ds.nodata,
+                dst_transform=grid.transform,
+                dst_crs=_crs_object(grid.crs),
+                dst_nodata=np.nan,
+                resampling=getattr(Resampling, resampling),
+            )
+        except Exception as exc:
+            raise CRSError(
+                f"{path}: cannot transform from {src_grid.crs!r} to {grid.crs!r} ({exc})"
+            ) from None
+    return dst
+
+
+# ------------------------------------------------------------------ point clouds
+
+
+def write_point_cloud(
+    path,
+    xyz: np.ndarray,
+    rgb: np.ndarray | None = None,
+    crs: str | None = None,
+    extra: dict[str, np.ndarray] | None = None,
+    scale: float = 0.001,
+) -> Path:
+    """Write a LAS 1.4 (``.las``) or LAZ (``.laz``) file atomically.
+
+    Parameters
+    ----------
+    xyz : (N, 3) float64
+        World coordinates (CRS units).
+    rgb : (N, 3) uint8 or uint16, optional
+        Colours; 8-bit values are scaled to LAS's 16-bit range (× 257).
+    crs : str, optional
+        Written as a WKT CRS VLR (LAS 1.4 global encoding WKT bit set).
+    extra : dict name -> (N,) array
+        Extra dimensions (float32, uint8, uint16, int32 ...), e.g. ``confidence``.
+    scale : float
+        Coordinate resolution (metres).
+    """
+    import laspy
+
+    p = Path(os.fspath(path))
+    if p.suffix.lower() not in POINT_CLOUD_EXTENSIONS:
+        raise InputError(f"point cloud {str(p)!r}: expected a file name ending in .las or .laz")
+    pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+    if not np.all(np.isfinite(pts)):
+        raise InputError(f"{p}: point coordinates must be finite")
+    n = len(pts)
+    header = laspy.LasHeader(point_format=7 if rgb is not None else 6, version="1.4")
+    header.scales = np.array([scale, scale, scale])
+    header.offsets = np.floor(pts.min(axis=0)) if n else np.zeros(3)
+    extra = extra or {}
+    for name, values in extra.items():
+        v = np.asarray(values)
+        if v.shape != (n,):
+            raise InputError(f"{p}: extra dimension {name!r} has shape {v.shape}, expected ({n},)")
+        header.add_extra_dim(laspy.ExtraBytesParams(name=name, type=v.dtype))
+    if crs is not None:
+        from .geometry.frame import parse_crs
+
+        header.add_crs(parse_crs(crs))
+    las = laspy.LasData(header)
+    las.x = pts[:, 0]
+    las.y = pts[:, 1]
+    las.z = pts[:, 2]
+    if rgb is not None:
+        c = np.asarray(rgb).reshape(-1, 3)
+        if len(c) != n:
+            raise InputError(f"{p}: {len(c)} colours for {n} points")
+        c16 = c.astype(np.uint16) * 257 if c.dtype == np.uint8 else c.astype(np.uint16)
+        las.red, las.green, las.blue = c16[:, 0], c16[:, 1], c16[:, 2]
+    for name, values in extra.items():
+        las[name] = np.asarray(values)
+    with atomic_output(p) as tmp:
+        try:
+            las.write(str(tmp), do_compress=p.suffix.lower() == ".laz")
+        except Exception as exc:
+            raise FormatError(p, f"cannot write the point cloud ({exc})") from None
+    return p

@@ -1,0 +1,130 @@
+"""RasterGrid / Tile plan and the atomic raster and point-cloud writers."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from truortho.core.errors import CRSError, InputError
+from truortho.core.grid import RasterGrid
+from truortho.core.rasterio_io import (
+    RasterWriter,
+    raster_grid,
+    read_onto_grid,
+    read_raster,
+    write_point_cloud,
+    write_raster,
+)
+
+
+def test_grid_from_extent_matches_cell_centre_convention():
+    g = RasterGrid.from_extent((100.0, 200.0, 110.05, 205.0), 0.5, "EPSG:32632")
+    assert g.shape == (10, 21)  # rounded up
+    assert g.geotransform == (100.0, 0.5, 0.0, 205.0, 0.0, -0.5)
+    X, Y = g.centres()
+    assert X[0, 0] == pytest.approx(100.25) and Y[0, 0] == pytest.approx(204.75)
+    r, c = g.cell_of(X[3, 7], Y[3, 7])
+    assert (r, c) == (pytest.approx(3.0), pytest.approx(7.0))
+
+
+@pytest.mark.parametrize("tile,overlap", [(4, 0), (4, 2), (7, 3), (100, 5)])
+def test_tiles_partition_the_grid(tile, overlap):
+    g = RasterGrid(0.0, 0.0, 1.0, 13, 17)
+    seen = np.zeros(g.shape, int)
+    for t in g.tiles(tile, overlap):
+        seen[t.core_slices] += 1
+        outer = np.zeros(g.shape, int)
+        outer[t.outer_slices] = 1
+        sub = outer[t.outer_slices]
+        assert sub[t.inner_slices].all()
+        r0, c0, nr, nc = t.outer
+        assert r0 >= 0 and c0 >= 0 and r0 + nr <= g.rows and c0 + nc <= g.cols
+        # the margin is `overlap` wherever the grid allows it
+        assert t.core[0] - r0 == min(overlap, t.core[0])
+    assert (seen == 1).all()
+
+
+def test_grid_rejects_bad_input():
+    with pytest.raises(InputError, match="resolution"):
+        RasterGrid.from_extent((0, 0, 1, 1), 0)
+    with pytest.raises(InputError, match="xmin < xmax"):
+        RasterGrid.from_extent((0, 0, -1, 1), 1)
+    with pytest.raises(InputError, match="cells"):
+        RasterGrid.from_extent((0, 0, 1e6, 1e6), 0.001)
+    with pytest.raises(InputError, match="north-up"):
+        RasterGrid.from_geotransform((0, 1, 0.2, 0, 0, -1), 3, 3)
+
+
+def test_raster_writer_tiles_roundtrip_and_nodata(tmp_path):
+    g = RasterGrid(500000.0, 5600000.0, 0.25, 300, 410, "EPSG:32632")
+    rng = np.random.default_rng(1)
+    full = rng.normal(size=g.shape).astype(np.float32)
+    full[5:9, 5:9] = np.nan
+    out = tmp_path / "dsm.tif"
+    with RasterWriter(out, g, dtype="float32", nodata=-9999.0, overviews=True) as w:
+        for t in g.tiles(128, 8):
+            tile = full[t.outer_slices]
+            w.write(np.where(np.isnan(tile), -9999.0, tile)[t.inner_slices], t.core)
+    data, g2, nodata = read_raster(out)
+    assert g2 == g and nodata == -9999.0
+    np.testing.assert_array_equal(np.isnan(data), np.isnan(full))
+    np.testing.assert_allclose(data[~np.isnan(data)], full[~np.isnan(full)])
+    assert raster_grid(out).crs == "EPSG:32632"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dsm.tif"]
+
+
+def test_failed_write_leaves_nothing_and_keeps_old_file(tmp_path):
+    g = RasterGrid(0.0, 10.0, 1.0, 10, 10, "EPSG:32632")
+    out = tmp_path / "a.tif"
+    write_raster(out, np.ones(g.shape, np.float32), g, nodata=-1.0)
+    with pytest.raises(RuntimeError):
+        with RasterWriter(out, g) as w:
+            w.write(np.zeros((10, 10), np.float32))
+            raise RuntimeError("cancelled half way")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.tif"]
+    assert read_raster(out)[0].min() == 1.0
+
+
+def test_cog_rgba(tmp_path):
+    g = RasterGrid(0.0, 600.0, 1.0, 600, 600, "EPSG:32632")
+    rgba = np.zeros((4, 600, 600), np.uint8)
+    rgba[:3] = 120
+    rgba[3, :300] = 255
+    out = tmp_path / "ortho.tif"
+    write_raster(out, rgba, g, nodata=None, alpha=True, cog=True)
+    import rasterio
+
+    with rasterio.open(out) as ds:
+        assert ds.count == 4 and ds.overviews(1) and ds.colorinterp[3].name == "alpha"
+        assert ds.profile["tiled"]
+
+
+def test_read_onto_grid_reprojects(tmp_path):
+    g = RasterGrid(500000.0, 5600100.0, 1.0, 100, 100, "EPSG:32632")
+    X, Y = g.centres()
+    write_raster(tmp_path / "plane.tif", (0.01 * (X - 500000) + 2.0).astype(np.float32), g, nodata=-9999.0)
+    sub = g.window(10, 10, 20, 20).scaled(1)
+    got = read_onto_grid(tmp_path / "plane.tif", sub)
+    Xs, _ = sub.centres()
+    np.testing.assert_allclose(got, 0.01 * (Xs - 500000) + 2.0, atol=1e-4)
+    with pytest.raises(CRSError):
+        read_onto_grid(tmp_path / "plane.tif", RasterGrid(0.0, 1.0, 1.0, 2, 2, None))
+
+
+@pytest.mark.parametrize("suffix", [".las", ".laz"])
+def test_point_cloud_roundtrip(tmp_path, suffix):
+    import laspy
+
+    rng = np.random.default_rng(0)
+    xyz = rng.uniform(0, 100, (500, 3)) + [500000.0, 5600000.0, 100.0]
+    rgb = rng.integers(0, 256, (500, 3)).astype(np.uint8)
+    conf = rng.uniform(0, 1, 500).astype(np.float32)
+    out = write_point_cloud(tmp_path / f"pc{suffix}", xyz, rgb, "EPSG:32632", {"confidence": conf})
+    las = laspy.read(out)
+    assert las.header.version.minor == 4 and len(las.points) == 500
+    np.testing.assert_allclose(np.column_stack([las.x, las.y, las.z]), xyz, atol=6e-4)
+    np.testing.assert_array_equal(np.asarray(las.red) // 257, rgb[:, 0])
+    np.testing.assert_allclose(np.asarray(las["confidence"]), conf)
+    assert las.header.parse_crs().to_epsg() == 32632
+    with pytest.raises(InputError, match=".las or .laz"):
+        write_point_cloud(tmp_path / "pc.xyz", xyz)
