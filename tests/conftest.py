@@ -25,6 +25,21 @@ REPO_ROOT = Path(__file__).resolve().parent.parent
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 
+def _shared_data_dir() -> str:
+    """The shared data sets: $TRUORTHO_DATA, else ../shared/data beside the clone, else /work/shared/data.
+
+    Test modules read ``os.environ["TRUORTHO_DATA"]`` (set here before they are imported)
+    and skip when the folder is missing.
+    """
+    for cand in (os.environ.get("TRUORTHO_DATA"), REPO_ROOT.parent / "shared" / "data", "/work/shared/data"):
+        if cand and Path(cand).is_dir():
+            return str(cand)
+    return str(REPO_ROOT.parent / "shared" / "data")
+
+
+os.environ["TRUORTHO_DATA"] = _shared_data_dir()
+
+
 def _ensure_truortho_importable() -> None:
     """Make ``import truortho`` work even outside the venv (whose .pth does it).
 

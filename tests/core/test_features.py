@@ -7,6 +7,7 @@ GPS pair selection, copr retrieval. Timings are printed (``pytest -s``).
 
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 
@@ -21,7 +22,7 @@ from truortho.core.sfm.matching import MatchConfig, match_descriptors, match_pai
 from truortho.core.sfm.pairs import PairConfig, exhaustive_pairs, select_pairs
 from truortho.core.sfm.twoview import TwoViewConfig, estimate_two_view
 
-DATA = Path("/work/shared/data")
+DATA = Path(os.environ["TRUORTHO_DATA"])
 FOUNTAIN = DATA / "fountain-P11"
 pytestmark = pytest.mark.skipif(not DATA.is_dir(), reason="shared data sets not available")
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 import warnings
 from pathlib import Path
 
@@ -24,8 +25,8 @@ from truortho.core.formats.opensfm import utm_crs
 from truortho.core.geometry import Camera, LocalFrame, matrix_to_axis_angle, opk_to_matrix, project_points
 from truortho.core.orientation import GCP, Image, Orientation, SparsePoints
 
-COPR = Path("/work/shared/data/copr/gcp_list.txt")
-BORUSZYN = Path("/work/shared/data/boruszyn/gcp_list.txt")
+COPR = Path(os.environ["TRUORTHO_DATA"]) / "copr" / "gcp_list.txt"
+BORUSZYN = Path(os.environ["TRUORTHO_DATA"]) / "boruszyn" / "gcp_list.txt"
 
 
 def make_orientation(seed: int = 1) -> Orientation:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +13,7 @@ from truortho.core.exif import focal_prior_px, read_exif
 from truortho.core.geometry import Camera
 from truortho.core.imagery import image_info, luminance, read_image, read_window, scaled_size
 
-DATA = Path("/work/shared/data")
+DATA = Path(os.environ["TRUORTHO_DATA"])
 need_data = pytest.mark.skipif(not DATA.is_dir(), reason="shared data sets not available")
 
 

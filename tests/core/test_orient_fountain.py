@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -11,7 +12,7 @@ from truortho.core.geometry.rotation import rotation_angle_between
 from truortho.core.sfm.pipeline import OrientConfig, orient_images
 from truortho.core.sfm.similarity import estimate_similarity
 
-DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "fountain-P11"
+DATA = Path(os.environ["TRUORTHO_DATA"]) / "fountain-P11"
 pytestmark = pytest.mark.skipif(not DATA.exists(), reason="shared data not available")
 
 
