@@ -18,12 +18,21 @@ Cost units, the valid-sample rule and the integer bounds are documented in
 """
 
 from .aggregation import DEFAULT_P1, DEFAULT_P2, P2_MAX, adaptive_p2, aggregate
-from .cost import COST_MAX, DEFAULT_MIN_VALID, DEFAULT_RADIUS, MEASURES, multi_image_cost, window_ncc
+from .cost import (
+    COST_MAX,
+    DEFAULT_MEASURE,
+    DEFAULT_MIN_VALID,
+    DEFAULT_RADIUS,
+    MEASURES,
+    multi_image_cost,
+    window_ncc,
+)
 from .rectified import disparity_costs, match_rectified
 from .selection import DEFAULT_UNIQUENESS, median_filter, select, valid_cells
 
 __all__ = [
     "COST_MAX",
+    "DEFAULT_MEASURE",
     "DEFAULT_MIN_VALID",
     "DEFAULT_P1",
     "DEFAULT_P2",

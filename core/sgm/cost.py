@@ -14,8 +14,12 @@ Costs are ``uint16`` in ``[0, COST_MAX]``. For NCC a pair contributes
 mismatch) and a cell's cost is ``round(COST_MAX * mean of the k best pair
 contributions)``; one cost unit is therefore ``1 / COST_MAX`` of correlation.
 For census a pair contributes ``min(2 h, 1)`` with ``h`` the fraction of
-differing bits (``h = 0.5`` is what unrelated windows give), so the two
-measures share one scale and one set of SGM penalties.
+differing bits (``h = 0.5`` is what unrelated windows give). For the
+saturated gradient measure (the default, see :func:`multi_image_cost`) a
+pair contributes ``min(m, 1)`` with ``m`` the window mean of
+``(|gx_a - gx_b| + |gy_a - gy_b|) / 2`` over saturated gradients in
+``[-1, 1]`` (unrelated windows give about 1). All measures thus share one
+scale (``COST_MAX`` = unrelated) and one set of SGM penalties.
 
 Valid samples (the rule used by every function here)
 ----------------------------------------------------
@@ -30,7 +34,11 @@ pair); where one is partial the statistics are recomputed over the common
 samples (exact, slower, only near NaN borders). A window is *flat* when its
 variance is at most ``FLAT_EPS^2 * (mean^2 + FLAT_EPS^2)``: NCC is undefined
 there (NaN from :func:`window_ncc`; the worst contribution, 1, in
-:func:`multi_image_cost`).
+:func:`multi_image_cost`). For the gradient measure the samples are the
+gradient samples (valid where the sample and at least one neighbour along
+the row and one along the column are); for
+census the bits (valid where the sample and the centre are; the centre
+itself counts as one sample).
 """
 
 from __future__ import annotations
@@ -54,7 +62,9 @@ _FLAT = -2.0
 #: Rows per parallel strip of the cost kernels (bounded memory per thread).
 _STRIP = 32
 #: Measures offered by :func:`multi_image_cost`.
-MEASURES = ("ncc", "census")
+MEASURES = ("gradient", "ncc", "census")
+#: Default measure (chosen by measurement, see the README).
+DEFAULT_MEASURE = "gradient"
 #: Default window radius (5 x 5 cells).
 DEFAULT_RADIUS = 2
 #: Default fraction of valid samples a window needs.
@@ -433,6 +443,200 @@ def _mic_census_kernel(sl, radius, min_valid, best_k, cost_out, nv_out):
                 cost_out[r, c] = np.uint16(min(cmax, m * cmax + 0.5))
 
 
+@njit
+def _diff1(a, x, b):
+    """Derivative from the samples before (a), at (x) and after (b): central
+    where both neighbours exist, else one-sided, NaN without neighbour."""
+    if x != x:
+        return np.nan
+    if a == a and b == b:
+        return 0.5 * (b - a)
+    if b == b:
+        return b - x
+    if a == a:
+        return x - a
+    return np.nan
+
+
+@njit
+def _gradients(sl, gx, gy):
+    """Derivatives along columns (gx) and rows (gy): central differences, one-sided
+    where a neighbour is missing (NaN or outside the grid), NaN without any."""
+    rows, cols = sl.shape
+    for r in range(rows):
+        for c in range(cols):
+            a = sl[r, c - 1] if c > 0 else np.nan
+            b = sl[r, c + 1] if c < cols - 1 else np.nan
+            gx[r, c] = _diff1(a, sl[r, c], b)
+            a = sl[r - 1, c] if r > 0 else np.nan
+            b = sl[r + 1, c] if r < rows - 1 else np.nan
+            gy[r, c] = _diff1(a, sl[r, c], b)
+
+
+@njit
+def _saturate(g, out):
+    """``clip(g / median|g|, -1, 1)`` over the valid samples (NaN kept); a zero
+    median (mostly flat slice) uses the mean of the non-zero |g| instead."""
+    vals = np.abs(g.ravel())
+    vals = vals[vals == vals]
+    scale = 0.0
+    if vals.size > 0:
+        scale = np.median(vals)
+        if scale <= 0.0:
+            nz = vals[vals > 0.0]
+            scale = nz.mean() if nz.size > 0 else 0.0
+    rows, cols = g.shape
+    for r in range(rows):
+        for c in range(cols):
+            v = g[r, c]
+            if v != v:
+                out[r, c] = np.nan
+            elif scale > 0.0:
+                out[r, c] = min(1.0, max(-1.0, v / scale))
+            else:
+                out[r, c] = 0.0
+
+
+@njit
+def _grad_count(gx, gy, r0, r1, radius, out):
+    """Valid (gx and gy) samples per window for rows ``[r0, r1)``."""
+    rows, cols = gx.shape
+    colsum = np.zeros(cols, np.int64)
+    for rr in range(max(0, r0 - radius), min(rows, r0 + radius + 1)):
+        for c in range(cols):
+            if gx[rr, c] == gx[rr, c] and gy[rr, c] == gy[rr, c]:
+                colsum[c] += 1
+    for r in range(r0, r1):
+        if r > r0:
+            ra = r + radius
+            if ra < rows:
+                for c in range(cols):
+                    if gx[ra, c] == gx[ra, c] and gy[ra, c] == gy[ra, c]:
+                        colsum[c] += 1
+            rs = r - radius - 1
+            if rs >= 0:
+                for c in range(cols):
+                    if gx[rs, c] == gx[rs, c] and gy[rs, c] == gy[rs, c]:
+                        colsum[c] -= 1
+        acc = 0
+        for c in range(min(cols, radius + 1)):
+            acc += colsum[c]
+        for c in range(cols):
+            if c > 0:
+                if c + radius < cols:
+                    acc += colsum[c + radius]
+                if c - radius - 1 >= 0:
+                    acc -= colsum[c - radius - 1]
+            out[r - r0, c] = acc
+
+
+@njit
+def _grad_pair(ax, ay, bx, by, r0, r1, radius, dsum, dcnt):
+    """Window sums of ``(|ax - bx| + |ay - by|) / 2`` and of the count over the
+    samples valid in both images, rows ``[r0, r1)``."""
+    rows, cols = ax.shape
+    cs = np.zeros(cols, np.float64)
+    cn = np.zeros(cols, np.int64)
+    for rr in range(max(0, r0 - radius), min(rows, r0 + radius + 1)):
+        for c in range(cols):
+            v = 0.5 * (abs(ax[rr, c] - bx[rr, c]) + abs(ay[rr, c] - by[rr, c]))
+            if v == v:
+                cs[c] += v
+                cn[c] += 1
+    for r in range(r0, r1):
+        if r > r0:
+            ra = r + radius
+            if ra < rows:
+                for c in range(cols):
+                    v = 0.5 * (abs(ax[ra, c] - bx[ra, c]) + abs(ay[ra, c] - by[ra, c]))
+                    if v == v:
+                        cs[c] += v
+                        cn[c] += 1
+            rs = r - radius - 1
+            if rs >= 0:
+                for c in range(cols):
+                    v = 0.5 * (abs(ax[rs, c] - bx[rs, c]) + abs(ay[rs, c] - by[rs, c]))
+                    if v == v:
+                        cs[c] -= v
+                        cn[c] -= 1
+        acc = 0.0
+        acn = 0
+        for c in range(min(cols, radius + 1)):
+            acc += cs[c]
+            acn += cn[c]
+        for c in range(cols):
+            if c > 0:
+                if c + radius < cols:
+                    acc += cs[c + radius]
+                    acn += cn[c + radius]
+                if c - radius - 1 >= 0:
+                    acc -= cs[c - radius - 1]
+                    acn -= cn[c - radius - 1]
+            dsum[r - r0, c] = acc
+            dcnt[r - r0, c] = acn
+
+
+@pjit
+def _prep_gradients(sl, gx, gy):
+    n = sl.shape[0]
+    tx = np.empty(sl.shape, np.float32)
+    ty = np.empty(sl.shape, np.float32)
+    for i in prange(n):
+        _gradients(sl[i], tx[i], ty[i])
+        _saturate(tx[i], gx[i])
+        _saturate(ty[i], gy[i])
+
+
+@pjit
+def _mic_grad_kernel(gx, gy, radius, min_valid, best_k, strip, cost_out, nv_out):
+    n, rows, cols = gx.shape
+    npairs = n * (n - 1) // 2
+    cmax = np.float64(COST_MAX)
+    nstrips = (rows + strip - 1) // strip
+    for s in prange(nstrips):
+        r0 = s * strip
+        r1 = min(rows, r0 + strip)
+        h = r1 - r0
+        cnt = np.empty((n, h, cols), np.int64)
+        for i in range(n):
+            _grad_count(gx[i], gy[i], r0, r1, radius, cnt[i])
+        pc = np.empty((npairs, h, cols), np.float32)
+        dsum = np.empty((h, cols), np.float64)
+        dcnt = np.empty((h, cols), np.int64)
+        p = 0
+        for i in range(n):
+            for j in range(i + 1, n):
+                _grad_pair(gx[i], gy[i], gx[j], gy[j], r0, r1, radius, dsum, dcnt)
+                for a in range(h):
+                    for c in range(cols):
+                        need = _need(_window_cells(r0 + a, c, rows, cols, radius), min_valid)
+                        if dcnt[a, c] >= need and cnt[i, a, c] >= need and cnt[j, a, c] >= need:
+                            pc[p, a, c] = min(1.0, dsum[a, c] / dcnt[a, c])
+                        else:
+                            pc[p, a, c] = np.nan
+                p += 1
+        col = np.empty(max(1, npairs), np.float32)
+        buf = np.empty(max(1, npairs), np.float32)
+        for a in range(h):
+            for c in range(cols):
+                need = _need(_window_cells(r0 + a, c, rows, cols, radius), min_valid)
+                nv = 0
+                for i in range(n):
+                    if cnt[i, a, c] >= need:
+                        nv += 1
+                nv_out[r0 + a, c] = nv
+                if nv < 2:
+                    cost_out[r0 + a, c] = COST_MAX
+                    continue
+                for q in range(npairs):
+                    col[q] = pc[q, a, c]
+                m = _combine(col, npairs, nv, best_k, buf)
+                if m < 0.0:
+                    cost_out[r0 + a, c] = COST_MAX
+                else:
+                    cost_out[r0 + a, c] = np.uint16(min(cmax, m * cmax + 0.5))
+
+
 # ---------------------------------------------------------------------------------------------
 # public API
 # ---------------------------------------------------------------------------------------------
@@ -484,7 +688,7 @@ def multi_image_cost(
     slices: np.ndarray,
     radius: int = DEFAULT_RADIUS,
     best_k: int | None = None,
-    measure: str = "ncc",
+    measure: str = DEFAULT_MEASURE,
     out: tuple[np.ndarray, np.ndarray] | None = None,
     *,
     min_valid: float = DEFAULT_MIN_VALID,
@@ -506,11 +710,19 @@ def multi_image_cost(
         for 2 or 3 views, 3 for 4, 6 for 5 or 6, 10 for 7, 15 for 9; robust to
         a third of the views being occluded. An integer caps k at the number
         of valid pairs.
-    measure : {"ncc", "census"}
-        ``"ncc"``: pairwise NCC (invariant to gain and offset per image).
-        ``"census"``: each image's window compared with its own centre
-        sample, Hamming distance between the images' bit strings over the
-        bits valid in both (invariant to any monotonic radiometry).
+    measure : {"gradient", "ncc", "census"}
+        ``"gradient"`` (default): each slice's gradients along rows and
+        columns of the grid (central differences, one-sided next to missing
+        samples),
+        divided by the slice's median absolute gradient and clipped to
+        [-1, 1] (invariant to gain and offset per image; weak texture stays
+        weak evidence instead of being normalised up, and the saturation
+        makes strong edges robust to contrast changes); a pair compares the
+        window mean of ``(|gx_a - gx_b| + |gy_a - gy_b|) / 2`` over the
+        samples valid in both. ``"ncc"``: pairwise NCC (invariant to gain
+        and offset). ``"census"``: each image's window compared with its own
+        centre sample, Hamming distance between the images' bit strings over
+        the bits valid in both (invariant to monotonic radiometry).
     out : (cost, n_views), optional
         Preallocated ``(rows, cols)`` uint16 and uint8 arrays (e.g. views of
         one level of a cost volume ``cost[:, :, k]``) to write into.
@@ -549,7 +761,12 @@ def multi_image_cost(
         if cost.shape != shape or cost.dtype != np.uint16 or nv.shape != shape or nv.dtype != np.uint8:
             raise InputError(f"out: expected ({shape} uint16, {shape} uint8) arrays")
     # kernels write through strided views too
-    if measure == "ncc":
+    if measure == "gradient":
+        gx = np.empty(s.shape, np.float32)
+        gy = np.empty(s.shape, np.float32)
+        _prep_gradients(np.ascontiguousarray(s), gx, gy)
+        _mic_grad_kernel(gx, gy, radius, min_valid, k, _STRIP, cost, nv)
+    elif measure == "ncc":
         z, vf = _prepare(s)
         _mic_ncc_kernel(z, vf, radius, min_valid, k, _STRIP, cost, nv)
     else:

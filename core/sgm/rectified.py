@@ -2,8 +2,11 @@
 
 The disparity space is treated exactly like OSGM's Z levels: for disparity
 ``d`` the two *slices* are the left image and the right image shifted right
-by ``d`` columns (``right_d[y, x] = right[y, x - d]``, NaN where ``x - d``
-leaves the image), and the same :func:`~.cost.multi_image_cost`,
+by ``d`` columns (``right_d[y, x] = right[y, x - d]``; where ``x - d`` leaves
+the image the right image's border column is repeated (``border="replicate"``,
+as most matchers do: those pixels have no true match, and uniform pseudo
+costs let the smoothness term extend the neighbouring surface into them) or
+the slice is NaN (``border="nan"``)), and the same :func:`~.cost.multi_image_cost`,
 :func:`~.aggregation.aggregate`, :func:`~.selection.select` and
 :func:`~.selection.median_filter` run on them.
 """
@@ -15,8 +18,8 @@ import numpy as np
 from ..errors import InputError
 from ..imagery import luminance
 from ..progress import Progress, check
-from .aggregation import DEFAULT_P1, DEFAULT_P2, adaptive_p2, aggregate
-from .cost import COST_MAX, DEFAULT_MIN_VALID, DEFAULT_RADIUS, multi_image_cost
+from .aggregation import DEFAULT_P1, DEFAULT_P2, aggregate
+from .cost import COST_MAX, DEFAULT_MEASURE, DEFAULT_MIN_VALID, DEFAULT_RADIUS, multi_image_cost
 from .selection import DEFAULT_UNIQUENESS, median_filter, select, valid_cells
 
 
@@ -36,7 +39,8 @@ def disparity_costs(
     num_disp: int,
     radius: int = DEFAULT_RADIUS,
     *,
-    measure: str = "ncc",
+    measure: str = DEFAULT_MEASURE,
+    border: str = "replicate",
     min_valid: float = DEFAULT_MIN_VALID,
     progress: Progress | None = None,
 ) -> np.ndarray:
@@ -44,22 +48,26 @@ def disparity_costs(
 
     ``left``, ``right`` are (H, W) float32 luminance images; returns
     (H, W, num_disp) uint16 from :func:`~.cost.multi_image_cost` of the
-    slices ``[left, right shifted by d]``.
+    slices ``[left, right shifted by d]`` (``border``: module docstring).
     """
+    if border not in ("replicate", "nan"):
+        raise InputError(f"border: expected 'replicate' or 'nan', got {border!r}")
     h, w = left.shape
     cost = np.empty((h, w, num_disp), np.uint16)
     nv = np.empty((h, w), np.uint8)
     pair = np.empty((2, h, w), np.float32)
     pair[0] = left
+    xs = np.arange(w)
     for k in range(num_disp):
         check(progress)
         d = min_disp + k
-        pair[1].fill(np.nan)
-        if d >= 0:
-            if d < w:
-                pair[1][:, d:] = right[:, : w - d]
-        elif -d < w:
-            pair[1][:, : w + d] = right[:, -d:]
+        src = xs - d
+        inside = (src >= 0) & (src < w)
+        if border == "replicate":
+            pair[1] = right[:, np.clip(src, 0, w - 1)]
+        else:
+            pair[1].fill(np.nan)
+            pair[1][:, inside] = right[:, src[inside]]
         c = np.empty((h, w), np.uint16)
         multi_image_cost(pair, radius, measure=measure, out=(c, nv), min_valid=min_valid)
         cost[:, :, k] = c
@@ -78,11 +86,12 @@ def match_rectified(
     paths: int = 8,
     radius: int = DEFAULT_RADIUS,
     *,
-    measure: str = "ncc",
-    adaptive: bool = False,
+    measure: str = DEFAULT_MEASURE,
+    adaptive: bool = True,
     uniqueness: float = DEFAULT_UNIQUENESS,
     median: int = 3,
     lr_check: float | None = None,
+    border: str = "replicate",
     min_valid: float = DEFAULT_MIN_VALID,
     progress: Progress | None = None,
 ) -> np.ndarray:
@@ -104,10 +113,11 @@ def match_rectified(
         Aggregation paths.
     radius : int
         Cost window radius (window side ``2 radius + 1``).
-    measure : {"ncc", "census"}
+    measure : {"gradient", "ncc", "census"}
         Matching cost (:func:`~.cost.multi_image_cost`).
     adaptive : bool
-        Lower P2 across edges of the left image (:func:`~.aggregation.adaptive_p2`).
+        Lower P2 per path step across intensity edges of the left image
+        (``guide`` of :func:`~.aggregation.aggregate`, default edge).
     uniqueness : float in (0, 1]
         Uniqueness ratio of :func:`~.selection.select` (1 disables it).
     median : int
@@ -116,6 +126,9 @@ def match_rectified(
         If given, also match right-to-left (the same cost volume, sheared) and
         reject pixels whose two disparities differ by more than this many
         pixels. Off by default: it doubles the aggregation time.
+    border : {"replicate", "nan"}
+        Right image beyond its border (module docstring). With ``"nan"``,
+        pixels whose disparities all leave the right image are NaN.
     min_valid : float in (0, 1]
         Fraction of a window that must be valid (:mod:`.cost`).
     progress : Progress, optional
@@ -141,11 +154,11 @@ def match_rectified(
     if lr_check is not None and not (float(lr_check) >= 0):
         raise InputError(f"lr_check: expected a non-negative disparity tolerance or None, got {lr_check!r}")
     cost = disparity_costs(
-        lg, rg, int(min_disp), int(num_disp), radius, measure=measure, min_valid=min_valid, progress=progress
-    )
+        lg, rg, int(min_disp), int(num_disp), radius, measure=measure, border=border,
+        min_valid=min_valid, progress=progress,
+    )  # fmt: skip
     check(progress)
-    p2v = adaptive_p2(lg, p1, p2) if adaptive else p2
-    s = aggregate(cost, p1, p2v, paths)
+    s = aggregate(cost, p1, p2, paths, guide=lg if adaptive else None)
     level, _ = select(s, uniqueness=uniqueness, valid=valid_cells(cost))
     del s
     disp = level + np.float32(min_disp)
@@ -161,8 +174,7 @@ def match_rectified(
                     cr[:, : w - d, k] = cost[:, d:, k]
             elif -d < w:
                 cr[:, -d:, k] = cost[:, : w + d, k]
-        p2r = adaptive_p2(rg, p1, p2) if adaptive else p2
-        sr = aggregate(cr, p1, p2r, paths)
+        sr = aggregate(cr, p1, p2, paths, guide=rg if adaptive else None)
         lr, _ = select(sr, uniqueness=uniqueness, valid=valid_cells(cr))
         del sr
         dr = lr + np.float32(min_disp)

@@ -114,6 +114,56 @@ def ref_multi_cost(slices, radius, best_k=None, min_valid=0.5, measure="ncc"):
     return cost, nviews
 
 
+def ref_derivative(x, axis):
+    x = np.moveaxis(x.astype(np.float64), axis, 0)
+    pad = np.full((1,) + x.shape[1:], np.nan)
+    a = np.concatenate([pad, x[:-1]])  # before
+    b = np.concatenate([x[1:], pad])  # after
+    g = np.where(np.isfinite(a) & np.isfinite(b), 0.5 * (b - a), np.where(np.isfinite(b), b - x, x - a))
+    return np.moveaxis(np.where(np.isfinite(x), g, np.nan), 0, axis)
+
+
+def ref_saturated_gradients(x):
+    gx, gy = ref_derivative(x, 1), ref_derivative(x, 0)
+    out = []
+    for g in (gx, gy):
+        v = np.abs(g[np.isfinite(g)])
+        s = np.median(v) if v.size else 0.0
+        if s <= 0 and v.size:
+            s = v[v > 0].mean() if (v > 0).any() else 0.0
+        out.append(np.clip(g / s, -1, 1) if s > 0 else np.where(np.isfinite(g), 0.0, np.nan))
+    return out
+
+
+def ref_gradient_cost(slices, radius, best_k=None, min_valid=0.5):
+    n, rows, cols = slices.shape
+    g = [ref_saturated_gradients(s) for s in slices]
+    cost = np.zeros((rows, cols), np.int64)
+    nviews = np.zeros((rows, cols), np.int64)
+    for r in range(rows):
+        for c in range(cols):
+            w = _window((rows, cols), r, c, radius)
+            need = _need(slices[0][w].size, min_valid)
+            ok = [(np.isfinite(g[i][0][w]) & np.isfinite(g[i][1][w])).sum() >= need for i in range(n)]
+            nv = sum(ok)
+            nviews[r, c] = nv
+            contrib = []
+            for i in range(n):
+                for j in range(i + 1, n):
+                    if not (ok[i] and ok[j]):
+                        continue
+                    dd = 0.5 * (np.abs(g[i][0][w] - g[j][0][w]) + np.abs(g[i][1][w] - g[j][1][w]))
+                    if np.isfinite(dd).sum() >= need:
+                        contrib.append(min(1.0, float(np.nanmean(dd))))
+            if nv < 2 or not contrib:
+                cost[r, c] = COST_MAX
+                continue
+            k = min(ref_k(nv, best_k), len(contrib))
+            m = float(np.mean(sorted(contrib)[:k]))
+            cost[r, c] = int(math.floor(min(COST_MAX, m * COST_MAX + 0.5)))
+    return cost, nviews
+
+
 def ref_census_pair(a, b, r, c, radius, need):
     rows, cols = a.shape
     nb = nd = 0
@@ -140,7 +190,7 @@ def _dirs(paths):
     return d + [(-a, -b) for a, b in d]
 
 
-def ref_aggregate(cost, p1, p2, paths=8, z0=None):
+def ref_aggregate(cost, p1, p2, paths=8, z0=None, guide=None, edge=0.0):
     rows, cols, nd = cost.shape
     z0 = np.zeros((rows, cols), int) if z0 is None else z0
     p2 = np.broadcast_to(np.asarray(p2), (rows, cols))
@@ -160,9 +210,13 @@ def ref_aggregate(cost, p1, p2, paths=8, z0=None):
                     mq = Lq.min()
                     lo = z0[q]  # absolute level of the neighbour's level 0
                     Lp = np.empty(nd, np.int64)
+                    pen2 = int(p2[r, c])
+                    if guide is not None:
+                        g = abs(float(guide[r, c]) - float(guide[q]))
+                        pen2 = max(min(pen2, p1 + 1), int(math.floor(pen2 * edge / (edge + g) + 0.5)))
                     for d in range(nd):
                         a = z0[r, c] + d
-                        cand = [mq + p2[r, c]]
+                        cand = [mq + pen2]
                         for b, pen in ((a, 0), (a - 1, p1), (a + 1, p1)):
                             if lo <= b < lo + nd:
                                 cand.append(Lq[b - lo] + pen)
@@ -261,7 +315,7 @@ def test_window_ncc_is_gain_offset_invariant_and_flags_flat(rng):
 def test_multi_image_cost_matches_reference(rng, n, best_k):
     s = _images(rng, n, (11, 14))
     s[n - 1, 5:, 6:] = np.nan  # an image that misses a corner
-    cost, nv = multi_image_cost(s, 2, best_k=best_k)
+    cost, nv = multi_image_cost(s, 2, best_k=best_k, measure="ncc")
     want, wnv = ref_multi_cost(s, 2, best_k)
     assert cost.dtype == np.uint16 and nv.dtype == np.uint8
     np.testing.assert_array_equal(nv, wnv)
@@ -274,12 +328,32 @@ def test_multi_image_cost_occluded_view_is_ignored(rng):
     base = rng.random((20, 20)).astype(np.float32)
     good = [g * base + o for g, o in ((1, 0), (2, 1), (0.5, 3), (1.5, -1))]
     bad = rng.random((20, 20)).astype(np.float32)
-    c_clean, _ = multi_image_cost(np.stack(good), 2)
-    c_occl, nv = multi_image_cost(np.stack(good + [bad]), 2)
+    c_clean, _ = multi_image_cost(np.stack(good), 2, measure="ncc")
+    c_occl, nv = multi_image_cost(np.stack(good + [bad]), 2, measure="ncc")
     assert (nv == 5).all()
     assert c_clean.max() <= 2 and c_occl.max() <= 2  # 5 views: best 6 pairs, all among the good 4
-    c_all, _ = multi_image_cost(np.stack(good + [bad]), 2, best_k=10)
+    c_all, _ = multi_image_cost(np.stack(good + [bad]), 2, best_k=10, measure="ncc")
     assert np.median(c_all) > 200  # averaging all pairs would be hurt
+
+
+@pytest.mark.parametrize("n,radius,best_k", [(2, 2, None), (3, 1, None), (4, 2, 2), (5, 3, None)])
+def test_gradient_cost_matches_reference(rng, n, radius, best_k):
+    s = _images(rng, n, (12, 15))
+    s[n - 1, 6:, 8:] = np.nan
+    cost, nv = multi_image_cost(s, radius, best_k=best_k, measure="gradient")
+    want, wnv = ref_gradient_cost(s, radius, best_k)
+    np.testing.assert_array_equal(nv, wnv)
+    assert np.abs(cost.astype(int) - want).max() <= 1
+    assert (cost[wnv < 2] == COST_MAX).all()
+
+
+def test_gradient_cost_is_gain_offset_invariant(rng):
+    base = rng.random((16, 18)).astype(np.float32)
+    s = np.stack([base, 3.0 * base + 2.0, 0.5 * base - 1.0])
+    cost, nv = multi_image_cost(s, 2, measure="gradient")
+    assert (nv == 3).all() and cost.max() <= 1
+    other = np.stack([base, rng.random((16, 18)).astype(np.float32)])
+    assert np.median(multi_image_cost(other, 2, measure="gradient")[0]) > 0.6 * COST_MAX
 
 
 @pytest.mark.parametrize("radius", [1, 2, 4])
@@ -331,6 +405,19 @@ def test_aggregate_matches_reference(rng, paths, offsets, per_cell_p2):
     want = ref_aggregate(cost, p1, p2, paths, z0)
     assert S.dtype == np.uint16
     np.testing.assert_array_equal(S.astype(np.int64), want)
+
+
+@pytest.mark.parametrize("paths", [8, 16])
+def test_aggregate_guided_p2_matches_reference(rng, paths):
+    rows, cols, nd = 8, 11, 5
+    cost = rng.integers(0, COST_MAX + 1, (rows, cols, nd)).astype(np.uint16)
+    guide = rng.random((rows, cols)).astype(np.float32)
+    z0 = rng.integers(-2, 3, (rows, cols)).astype(np.int32)
+    S = aggregate(cost, 50, 700, paths=paths, z0=z0, guide=guide, edge=0.3)
+    np.testing.assert_array_equal(S.astype(np.int64), ref_aggregate(cost, 50, 700, paths, z0, guide, 0.3))
+    # default edge: 4 x median step; a constant guide changes nothing
+    flat = aggregate(cost, 50, 700, paths=paths, guide=np.ones((rows, cols), np.float32))
+    np.testing.assert_array_equal(flat, aggregate(cost, 50, 700, paths=paths))
 
 
 def test_aggregate_worst_case_does_not_overflow():
@@ -436,9 +523,19 @@ def test_kernels_pure_python_on_tiny_inputs(rng):
     c = np.empty((6, 7), np.uint16)
     nv = np.empty((6, 7), np.uint8)
     cost_mod._mic_ncc_kernel.py_func(z, vf, 1, 0.5, 0, 4, c, nv)
-    want, wnv = ref_multi_cost(s, 1)
+    want, wnv = ref_multi_cost(s, 1, measure="ncc")
     np.testing.assert_array_equal(nv, wnv)
     assert np.abs(c.astype(int) - want).max() <= 1
+    gx = np.empty(s.shape, np.float32)
+    gy = np.empty(s.shape, np.float32)
+    cost_mod._prep_gradients.py_func(s, gx, gy)
+    cost_mod._mic_grad_kernel.py_func(gx, gy, 1, 0.5, 0, 4, c, nv)
+    assert np.abs(c.astype(int) - ref_gradient_cost(s, 1)[0]).max() <= 1
+    tx = np.empty((6, 7), np.float32)
+    ty = np.empty((6, 7), np.float32)
+    cost_mod._gradients.py_func(s[0], tx, ty)
+    cost_mod._saturate.py_func(tx, gx[0])
+    np.testing.assert_allclose(gx[0], ref_saturated_gradients(s[0])[0], atol=1e-6)
     cost_mod._mic_census_kernel.py_func(s, 1, 0.5, 0, c, nv)
     np.testing.assert_array_equal(c.astype(int), ref_multi_cost(s, 1, measure="census")[0])
     out = np.empty((6, 7), np.float32)
@@ -450,10 +547,12 @@ def test_kernels_pure_python_on_tiny_inputs(rng):
     z0 = rng.integers(-2, 3, (5, 6)).astype(np.int32)
     p2 = np.full((5, 6), 300, np.int32)
     S = np.empty(cost.shape, np.uint16)
-    agg_mod._agg_rows.py_func(cost, z0, p2, 60, S)
-    agg_mod._agg_sweep.py_func(cost, z0, p2, 60, S, agg_mod._DOWN16, True)
-    agg_mod._agg_sweep.py_func(cost, z0, p2, 60, S, agg_mod._DOWN16, False)
-    np.testing.assert_array_equal(S.astype(np.int64), ref_aggregate(cost, 60, 300, 16, z0))
+    guide = rng.random((5, 6)).astype(np.float32)
+    agg_mod._agg_rows.py_func(cost, z0, p2, guide, 0.2, 60, S)
+    agg_mod._agg_sweep.py_func(cost, z0, p2, guide, 0.2, 60, S, agg_mod._DOWN16, True)
+    agg_mod._agg_sweep.py_func(cost, z0, p2, guide, 0.2, 60, S, agg_mod._DOWN16, False)
+    np.testing.assert_array_equal(S.astype(np.int64), ref_aggregate(cost, 60, 300, 16, z0, guide, 0.2))
+    assert agg_mod._p2_step.py_func(p2, guide, 0.2, 60, 1, 1, 0, 0) >= 61
     for kern in (agg_mod._first, agg_mod._step):
         assert hasattr(kern, "py_func")
     L = np.full(8, agg_mod._SENT, np.uint16)
