@@ -50,7 +50,7 @@ def plane_sweep():
     slices = np.empty((len(zs), len(images), rows, cols), np.float32)
     for k, z in enumerate(zs):
         P = np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, z)]) - scene.offset
-        for i, (img, ori) in enumerate(zip(images, scene.orientation.images)):
+        for i, (img, ori) in enumerate(zip(images, scene.orientation.images, strict=True)):
             uv = project_points(P, ori.R, ori.C, scene.camera).reshape(rows, cols, 2).astype(np.float32)
             slices[k, i] = cv2.remap(img, uv[..., 0], uv[..., 1], cv2.INTER_LINEAR, borderValue=np.nan)
     return dict(slices=slices, zs=zs, dz=dz, dsm=dsm)
