@@ -32,12 +32,17 @@ fits ``uint16`` for every accepted ``P2 <= P2_MAX``; path costs and ``S`` are
 
 Parallel layout
 ---------------
-The two horizontal paths are independent per row (``prange`` over rows).
-All other paths step at least one row, so all cells of one row depend only
-on earlier rows: a top-down sweep and a bottom-up sweep each carry the path
-costs of the last two rows (the only buffers besides ``S``) and run the
-cells of a row in parallel; the paths of one sweep are fused so that the
-cost and ``S`` of a cell are touched once per sweep.
+All paths of one vertical direction are fused into one sweep: the top-down
+sweep (left to right within a row) carries the left-to-right horizontal path
+and the paths stepping down (vertical, both diagonals, and for 16 paths the
+four knight moves), the bottom-up sweep (right to left) the mirror images;
+each carries the path costs of its last three rows (the only buffers
+besides ``S``), and a cell's costs and ``S`` are touched once per sweep. The
+two sweeps run on two threads with a single synchronisation: first the
+down sweep over the top half of the rows and the up sweep over the bottom
+half, then the other halves; in each phase they write disjoint rows of
+``S``. (Per-row parallelism would need a barrier per row, which costs more
+than it gains on a loaded two-core machine.)
 """
 
 from __future__ import annotations
@@ -66,64 +71,202 @@ _DOWN16 = np.array([[1, 0], [1, 1], [1, -1], [1, 2], [1, -2], [2, 1], [2, -1]], 
 _SENT = 32767
 
 
-@njit
-def _first(cost, r, c, lout, s, assign):
-    """Start of a path at (r, c): L = C. Returns min_d L."""
-    nd = cost.shape[2]
-    mn = 1 << 30
-    for d in range(nd):
-        v = np.int64(cost[r, c, d])
-        lout[d + 2] = v
-        if assign:
-            s[r, c, d] = v
-        else:
-            s[r, c, d] += v
-        if v < mn:
-            mn = v
-    return mn
+_U = np.uint64
 
 
 @njit
-def _step(cost, r, c, lq, mq, lout, off, p1, p2, s, assign):
-    """One path step into (r, c) from a neighbour with path costs ``lq``.
+def _first(cf, cb, lf, ob, sf, nd, assign):
+    """Start of a path at the cell whose costs start at ``cf[cb]``: L = C.
 
-    ``lq``/``lout`` are padded: level k at index k + 2, sentinels at 0, 1,
-    nd + 2, nd + 3. ``off = z0[p] - z0[q]`` maps level d of p to level
-    d + off of q. Adds (or assigns) the new path costs to ``s[r, c]``;
-    returns their minimum.
+    Flat buffers with unsigned offsets (no array views: each view costs an
+    atomic reference count, and signed indices cost wraparound code that
+    stops vectorisation): ``lf[ob + 2 + d]`` receives L, ``sf[cb + d]`` (S has
+    the layout of the costs) is increased by it (set to it when ``assign``:
+    the first path written into a cell). Returns min_d L.
     """
-    nd = cost.shape[2]
-    base = mq + p2
+    mn = np.uint16(65535)
+    o = ob + _U(2)
+    if assign:  # separate loops: a conditional load would not vectorise
+        for d in range(nd):
+            i = _U(d)
+            v = cf[cb + i]
+            lf[o + i] = v
+            sf[cb + i] = v
+            mn = min(mn, v)
+    else:
+        for d in range(nd):
+            i = _U(d)
+            v = cf[cb + i]
+            lf[o + i] = v
+            sf[cb + i] = np.uint16(sf[cb + i] + v)
+            mn = min(mn, v)
+    return np.int64(mn)
+
+
+@njit
+def _step(cf, cb, lf, qb, mq, ob, off, p1, p2, sf, nd, assign):
+    """One path step into the cell with costs ``cf[cb:cb + nd]`` from a neighbour
+    whose path costs are ``lf[qb + 2 + k]`` (minimum ``mq``).
+
+    Path-cost buffers are padded: level k at offset k + 2, sentinels at 0, 1,
+    nd + 2, nd + 3. ``off = z0[p] - z0[q]`` maps level d of p to level
+    d + off of q. Writes the new path costs to ``lf[ob + 2 + d]``, adds them
+    to ``sf[cb + d]`` (or sets it, ``assign``); returns their minimum. All arithmetic stays in
+    ``uint16`` (no value exceeds ``COST_MAX + P2_MAX`` or the sentinel plus
+    P1, and ``min(...) >= mq``), so the main loop vectorises.
+    """
+    u1 = np.uint16(p1)
+    u2 = np.uint16(p2)
+    m16 = np.uint16(mq)
+    base = np.uint16(mq + p2)
     lo = min(max(-off - 1, 0), nd)
     hi = min(max(nd - off + 1, 0), nd)
-    mn = 1 << 30
+    o = ob + _U(2)
+    mn = np.uint16(65535)
     for d in range(lo):
-        v = np.int64(cost[r, c, d]) + p2
-        lout[d + 2] = v
-        if assign:
-            s[r, c, d] = v
-        else:
-            s[r, c, d] += v
+        i = _U(d)
+        v = np.uint16(cf[cb + i] + u2)
+        lf[o + i] = v
+        sf[cb + i] = v if assign else np.uint16(sf[cb + i] + v)
         mn = min(mn, v)
-    for d in range(lo, hi):
-        e = d + off + 2
-        v = min(min(np.int64(lq[e]), np.int64(lq[e - 1]) + p1), min(np.int64(lq[e + 1]) + p1, base))
-        v = v + np.int64(cost[r, c, d]) - mq
-        lout[d + 2] = v
-        if assign:
-            s[r, c, d] = v
-        else:
-            s[r, c, d] += v
-        mn = min(mn, v)
+    e = qb + _U(lo + off + 1)  # offset of neighbour level (lo + off - 1); lo + off + 1 >= 0
+    c0 = cb + _U(lo)
+    o0 = o + _U(lo)
+    if assign:  # separate loops: a conditional load would not vectorise
+        for d in range(hi - lo):
+            t = _U(d)
+            a = min(lf[e + _U(1) + t], np.uint16(lf[e + t] + u1))
+            b = min(np.uint16(lf[e + _U(2) + t] + u1), base)
+            v = np.uint16(np.uint16(min(a, b) - m16) + cf[c0 + t])
+            lf[o0 + t] = v
+            sf[c0 + t] = v
+            mn = min(mn, v)
+    else:
+        for d in range(hi - lo):
+            t = _U(d)
+            a = min(lf[e + _U(1) + t], np.uint16(lf[e + t] + u1))
+            b = min(np.uint16(lf[e + _U(2) + t] + u1), base)
+            v = np.uint16(np.uint16(min(a, b) - m16) + cf[c0 + t])
+            lf[o0 + t] = v
+            sf[c0 + t] = np.uint16(sf[c0 + t] + v)
+            mn = min(mn, v)
     for d in range(hi, nd):
-        v = np.int64(cost[r, c, d]) + p2
-        lout[d + 2] = v
-        if assign:
-            s[r, c, d] = v
-        else:
-            s[r, c, d] += v
+        i = _U(d)
+        v = np.uint16(cf[cb + i] + u2)
+        lf[o + i] = v
+        sf[cb + i] = v if assign else np.uint16(sf[cb + i] + v)
         mn = min(mn, v)
-    return mn
+    return np.int64(mn)
+
+
+@njit
+def _step4(
+    cf, cb, lf, q0, q1, q2, q3, m0, m1, m2, m3, o0, o1, o2, o3, p1, p20, p21, p22, p23, sf, nd, assign
+):
+    """Four path steps into one cell at once, for neighbours on the same level
+    window (offset 0): one pass over the levels, one update of S. Path k reads
+    ``lf[qk + 2 + d]`` (minimum ``mk``) and writes ``lf[ok + 2 + d]``; returns the
+    four minima. Same arithmetic as :func:`_step`."""
+    u1 = np.uint16(p1)
+    a0 = np.uint16(m0)
+    a1 = np.uint16(m1)
+    a2 = np.uint16(m2)
+    a3 = np.uint16(m3)
+    b0 = np.uint16(m0 + p20)
+    b1 = np.uint16(m1 + p21)
+    b2 = np.uint16(m2 + p22)
+    b3 = np.uint16(m3 + p23)
+    n0 = np.uint16(65535)
+    n1 = np.uint16(65535)
+    n2 = np.uint16(65535)
+    n3 = np.uint16(65535)
+    two = _U(2)
+    one = _U(1)
+    if assign:  # separate loops: a conditional load would not vectorise
+        for d in range(nd):
+            t = _U(d)
+            cc = cf[cb + t]
+            e = q0 + one + t
+            v0 = np.uint16(
+                np.uint16(
+                    min(min(lf[e + one], np.uint16(lf[e] + u1)), min(np.uint16(lf[e + two] + u1), b0)) - a0
+                )
+                + cc
+            )
+            e = q1 + one + t
+            v1 = np.uint16(
+                np.uint16(
+                    min(min(lf[e + one], np.uint16(lf[e] + u1)), min(np.uint16(lf[e + two] + u1), b1)) - a1
+                )
+                + cc
+            )
+            e = q2 + one + t
+            v2 = np.uint16(
+                np.uint16(
+                    min(min(lf[e + one], np.uint16(lf[e] + u1)), min(np.uint16(lf[e + two] + u1), b2)) - a2
+                )
+                + cc
+            )
+            e = q3 + one + t
+            v3 = np.uint16(
+                np.uint16(
+                    min(min(lf[e + one], np.uint16(lf[e] + u1)), min(np.uint16(lf[e + two] + u1), b3)) - a3
+                )
+                + cc
+            )
+            lf[o0 + two + t] = v0
+            lf[o1 + two + t] = v1
+            lf[o2 + two + t] = v2
+            lf[o3 + two + t] = v3
+            v = np.uint16(np.uint16(v0 + v1) + np.uint16(v2 + v3))
+            sf[cb + t] = v
+            n0 = min(n0, v0)
+            n1 = min(n1, v1)
+            n2 = min(n2, v2)
+            n3 = min(n3, v3)
+    else:
+        for d in range(nd):
+            t = _U(d)
+            cc = cf[cb + t]
+            e = q0 + one + t
+            v0 = np.uint16(
+                np.uint16(
+                    min(min(lf[e + one], np.uint16(lf[e] + u1)), min(np.uint16(lf[e + two] + u1), b0)) - a0
+                )
+                + cc
+            )
+            e = q1 + one + t
+            v1 = np.uint16(
+                np.uint16(
+                    min(min(lf[e + one], np.uint16(lf[e] + u1)), min(np.uint16(lf[e + two] + u1), b1)) - a1
+                )
+                + cc
+            )
+            e = q2 + one + t
+            v2 = np.uint16(
+                np.uint16(
+                    min(min(lf[e + one], np.uint16(lf[e] + u1)), min(np.uint16(lf[e + two] + u1), b2)) - a2
+                )
+                + cc
+            )
+            e = q3 + one + t
+            v3 = np.uint16(
+                np.uint16(
+                    min(min(lf[e + one], np.uint16(lf[e] + u1)), min(np.uint16(lf[e + two] + u1), b3)) - a3
+                )
+                + cc
+            )
+            lf[o0 + two + t] = v0
+            lf[o1 + two + t] = v1
+            lf[o2 + two + t] = v2
+            lf[o3 + two + t] = v3
+            v = np.uint16(np.uint16(v0 + v1) + np.uint16(v2 + v3))
+            sf[cb + t] = np.uint16(sf[cb + t] + v)
+            n0 = min(n0, v0)
+            n1 = min(n1, v1)
+            n2 = min(n2, v2)
+            n3 = min(n3, v3)
+    return np.int64(n0), np.int64(n1), np.int64(n2), np.int64(n3)
 
 
 @njit
@@ -140,50 +283,148 @@ def _p2_step(p2m, guide, edge, p1, r, c, rq, cq):
     return p2
 
 
-@pjit
-def _agg_rows(cost, z0, p2m, guide, edge, p1, s):
-    """Both horizontal paths; assigns S (first kernel of :func:`aggregate`)."""
-    rows, cols, nd = cost.shape
-    for r in prange(rows):
-        la = np.full(nd + 4, _SENT, np.uint16)
-        lb = np.full(nd + 4, _SENT, np.uint16)
-        mq = _first(cost, r, 0, la, s, True)
-        for c in range(1, cols):
-            p2 = _p2_step(p2m, guide, edge, p1, r, c, r, c - 1)
-            mq = _step(cost, r, c, la, mq, lb, np.int64(z0[r, c]) - z0[r, c - 1], p1, p2, s, True)
-            la, lb = lb, la
-        mq = _first(cost, r, cols - 1, la, s, False)
-        for c in range(cols - 2, -1, -1):
-            p2 = _p2_step(p2m, guide, edge, p1, r, c, r, c + 1)
-            mq = _step(cost, r, c, la, mq, lb, np.int64(z0[r, c]) - z0[r, c + 1], p1, p2, s, False)
-            la, lb = lb, la
+@njit
+def _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, down, i0, i1, lf, mbuf, touch):
+    """Steps ``i0 <= i < i1`` of one vertical sweep, all its paths fused.
 
-
-@pjit
-def _agg_sweep(cost, z0, p2m, guide, edge, p1, s, dirs, down):
-    """All non-horizontal paths of one vertical sweep (top-down or bottom-up); adds to S."""
+    Down (``down``): rows ``i`` top to bottom, columns left to right, with the
+    left-to-right horizontal path; up: rows ``rows - 1 - i``, columns right
+    to left, with the right-to-left path. ``dirs`` are the non-horizontal
+    directions (row step > 0, negated for the up sweep). ``lf`` is flat
+    ``(3, k, cols, nd + 4)`` followed by ``(2, nd + 4)``: the path costs of
+    the last three rows and of the horizontal path; ``mbuf`` (3, k, cols)
+    their minima. The buffers persist between calls, so a sweep can be split
+    in row ranges (the horizontal path restarts on every row). ``touch``: this
+    call is the first to write these rows of ``s`` (it assigns instead of
+    adding). Paths are stepped four at a time (:func:`_step4`) where the four
+    neighbours share the cell's level window.
+    """
     rows, cols, nd = cost.shape
     nk = dirs.shape[0]
-    lbuf = np.full((3, nk, cols, nd + 4), _SENT, np.uint16)
-    mbuf = np.zeros((3, nk, cols), np.int64)
+    npth = nk + 1
+    cf = cost.reshape(-1)
+    sf = s.reshape(-1)
+    w = nd + 4
+    und = _U(nd)
+    hoff = 3 * nk * cols * w
     sgn = 1 if down else -1
-    for i in range(rows):
+    reach = 0  # largest column step of the directions
+    for k in range(nk):
+        reach = max(reach, abs(dirs[k, 1]))
+    start = np.empty(npth, np.bool_)
+    qbs = np.empty(npth, np.uint64)
+    obs = np.empty(npth, np.uint64)
+    mqs = np.empty(npth, np.int64)
+    offs = np.empty(npth, np.int64)
+    p2s = np.empty(npth, np.int64)
+    mout = np.empty(npth, np.int64)
+    hm = np.int64(0)  # a local: the two sweeps' threads must not share a cache line
+    for i in range(i0, i1):
         r = i if down else rows - 1 - i
         slot = i % 3
-        for c in prange(cols):
+        qs1 = (i - 1) % 3
+        rq1 = r - sgn
+        inner_row = nk == 3 and 0 <= rq1 < rows
+        for j in range(cols):
+            c = j if down else cols - 1 - j
+            cb = _U(r * cols + c) * und
+            zc = np.int64(z0[r, c])
+            if inner_row and j > 0 and reach <= c < cols - reach:
+                # 8 paths, interior cell: horizontal, vertical, both diagonals in one pass
+                c1 = c - sgn * dirs[1, 1]
+                c2 = c - sgn * dirs[2, 1]
+                cq = c - sgn
+                if z0[r, cq] == zc and z0[rq1, c] == zc and z0[rq1, c1] == zc and z0[rq1, c2] == zc:
+                    row = (qs1 * nk) * cols
+                    hm, m1, m2, m3 = _step4(
+                        cf, cb, lf,
+                        _U(hoff + ((j - 1) % 2) * w), _U((row + c) * w),
+                        _U((row + cols + c1) * w), _U((row + 2 * cols + c2) * w),
+                        hm, mbuf[qs1, 0, c], mbuf[qs1, 1, c1], mbuf[qs1, 2, c2],
+                        _U(hoff + (j % 2) * w), _U(((slot * nk) * cols + c) * w),
+                        _U(((slot * nk + 1) * cols + c) * w), _U(((slot * nk + 2) * cols + c) * w),
+                        p1, _p2_step(p2m, guide, edge, p1, r, c, r, cq),
+                        _p2_step(p2m, guide, edge, p1, r, c, rq1, c),
+                        _p2_step(p2m, guide, edge, p1, r, c, rq1, c1),
+                        _p2_step(p2m, guide, edge, p1, r, c, rq1, c2), sf, nd, touch,
+                    )  # fmt: skip
+                    mbuf[slot, 0, c] = m1
+                    mbuf[slot, 1, c] = m2
+                    mbuf[slot, 2, c] = m3
+                    continue
+            # path 0: horizontal (from c - 1 going down, from c + 1 going up)
+            obs[0] = _U(hoff + (j % 2) * w)
+            start[0] = j == 0
+            if j > 0:
+                cq = c - sgn
+                qbs[0] = _U(hoff + ((j - 1) % 2) * w)
+                mqs[0] = hm
+                offs[0] = zc - z0[r, cq]
+                p2s[0] = _p2_step(p2m, guide, edge, p1, r, c, r, cq)
             for k in range(nk):
                 dr = dirs[k, 0]
                 rq = r - sgn * dr
                 cq = c - sgn * dirs[k, 1]
-                if rq < 0 or rq >= rows or cq < 0 or cq >= cols:
-                    mbuf[slot, k, c] = _first(cost, r, c, lbuf[slot, k, c], s, False)
-                else:
+                obs[k + 1] = _U(((slot * nk + k) * cols + c) * w)
+                st = rq < 0 or rq >= rows or cq < 0 or cq >= cols
+                start[k + 1] = st
+                if not st:
                     qs = (i - dr) % 3
-                    p2 = _p2_step(p2m, guide, edge, p1, r, c, rq, cq)
-                    mbuf[slot, k, c] = _step(
-                        cost, r, c, lbuf[qs, k, cq], mbuf[qs, k, cq], lbuf[slot, k, c],
-                        np.int64(z0[r, c]) - z0[rq, cq], p1, p2, s, False,
-                    )  # fmt: skip
+                    qbs[k + 1] = _U(((qs * nk + k) * cols + cq) * w)
+                    mqs[k + 1] = mbuf[qs, k, cq]
+                    offs[k + 1] = zc - z0[rq, cq]
+                    p2s[k + 1] = _p2_step(p2m, guide, edge, p1, r, c, rq, cq)
+            g = 0
+            assign = touch
+            while g < npth:
+                if g + 4 <= npth:
+                    fuse = True
+                    for q in range(g, g + 4):
+                        if start[q] or offs[q] != 0:
+                            fuse = False
+                    if fuse:
+                        mout[g], mout[g + 1], mout[g + 2], mout[g + 3] = _step4(
+                            cf, cb, lf, qbs[g], qbs[g + 1], qbs[g + 2], qbs[g + 3],
+                            mqs[g], mqs[g + 1], mqs[g + 2], mqs[g + 3],
+                            obs[g], obs[g + 1], obs[g + 2], obs[g + 3],
+                            p1, p2s[g], p2s[g + 1], p2s[g + 2], p2s[g + 3], sf, nd, assign,
+                        )  # fmt: skip
+                        assign = False
+                        g += 4
+                        continue
+                if start[g]:
+                    mout[g] = _first(cf, cb, lf, obs[g], sf, nd, assign)
+                else:
+                    mout[g] = _step(cf, cb, lf, qbs[g], mqs[g], obs[g], offs[g], p1, p2s[g], sf, nd, assign)
+                assign = False
+                g += 1
+            hm = mout[0]
+            for k in range(nk):
+                mbuf[slot, k, c] = mout[k + 1]
+
+
+@pjit
+def _aggregate_kernel(cost, z0, p2m, guide, edge, p1, s, dirs):
+    """Both sweeps on two threads: phase 0 runs the down sweep on the top half
+    of the rows and the up sweep on the bottom half (each writes its rows of
+    ``s`` first), phase 1 swaps the halves (adding); in each phase the two
+    tasks touch disjoint rows of ``s``."""
+    rows, cols, nd = cost.shape
+    nk = dirs.shape[0]
+    n = (3 * nk * cols + 2) * (nd + 4)
+    lf = np.full(2 * n, _SENT, np.uint16)
+    mbuf = np.zeros((2, 3, nk, cols), np.int64)
+    half = rows // 2
+    for phase in range(2):
+        for t in prange(2):
+            if t == 0:
+                a = 0 if phase == 0 else half
+                b = half if phase == 0 else rows
+                _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, True, a, b, lf[:n], mbuf[0], phase == 0)
+            else:
+                a = 0 if phase == 0 else rows - half
+                b = rows - half if phase == 0 else rows
+                _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, False, a, b, lf[n:], mbuf[1], phase == 0)
 
 
 def _check_p(p1, p2, shape) -> tuple[int, np.ndarray]:
@@ -272,11 +513,8 @@ def aggregate(
     z = _check_z0(z0, shape)
     g, e = _check_guide(guide, edge, shape)
     c = np.ascontiguousarray(c)
-    s = np.empty(c.shape, np.uint16)
-    _agg_rows(c, z, p2m, g, e, p1i, s)
-    dirs = _DOWN8 if paths == 8 else _DOWN16
-    _agg_sweep(c, z, p2m, g, e, p1i, s, dirs, True)
-    _agg_sweep(c, z, p2m, g, e, p1i, s, dirs, False)
+    s = np.empty(c.shape, np.uint16)  # every cell is assigned by its first sweep
+    _aggregate_kernel(c, z, p2m, g, e, p1i, s, _DOWN8 if paths == 8 else _DOWN16)
     return s
 
 

@@ -546,21 +546,39 @@ def test_kernels_pure_python_on_tiny_inputs(rng):
     cost = rng.integers(0, COST_MAX + 1, (5, 6, 4)).astype(np.uint16)
     z0 = rng.integers(-2, 3, (5, 6)).astype(np.int32)
     p2 = np.full((5, 6), 300, np.int32)
-    S = np.empty(cost.shape, np.uint16)
     guide = rng.random((5, 6)).astype(np.float32)
-    agg_mod._agg_rows.py_func(cost, z0, p2, guide, 0.2, 60, S)
-    agg_mod._agg_sweep.py_func(cost, z0, p2, guide, 0.2, 60, S, agg_mod._DOWN16, True)
-    agg_mod._agg_sweep.py_func(cost, z0, p2, guide, 0.2, 60, S, agg_mod._DOWN16, False)
+    S = np.zeros(cost.shape, np.uint16)
+    agg_mod._aggregate_kernel.py_func(cost, z0, p2, guide, 0.2, 60, S, agg_mod._DOWN16)
     np.testing.assert_array_equal(S.astype(np.int64), ref_aggregate(cost, 60, 300, 16, z0, guide, 0.2))
+    S2 = np.zeros(cost.shape, np.uint16)  # the sweeps themselves without the JIT, in two row ranges
+    for down in (True, False):
+        lf = np.full((3 * 3 * 6 + 2) * 8, agg_mod._SENT, np.uint16)
+        mb = np.zeros((3, 3, 6), np.int64)
+        for i0, i1 in ((0, 2), (2, 5)):
+            agg_mod._sweep.py_func(cost, z0, p2, guide, 0.2, 60, S2, agg_mod._DOWN8, down, i0, i1, lf, mb, False)
+    np.testing.assert_array_equal(S2.astype(np.int64), ref_aggregate(cost, 60, 300, 8, z0, guide, 0.2))
     assert agg_mod._p2_step.py_func(p2, guide, 0.2, 60, 1, 1, 0, 0) >= 61
-    for kern in (agg_mod._first, agg_mod._step):
-        assert hasattr(kern, "py_func")
-    L = np.full(8, agg_mod._SENT, np.uint16)
-    Lo = L.copy()
-    s_ = np.zeros((1, 1, 4), np.uint16)
-    agg_mod._first.py_func(cost[:1, :1], 0, 0, L, s_, True)
-    m = agg_mod._step.py_func(cost[:1, :1], 0, 0, L, int(L[2:6].min()), Lo, 1, 60, 300, s_, False)
-    assert m == Lo[2:6].min()
+    U = np.uint64
+    cf = cost.reshape(-1)
+    L = np.full(16, agg_mod._SENT, np.uint16)
+    sf = np.zeros(cf.size, np.uint16)
+    m0 = agg_mod._first.py_func(cf, U(0), L, U(0), sf, 4, False)
+    m = agg_mod._step.py_func(cf, U(4), L, U(0), m0, U(8), 1, 60, 300, sf, 4, True)
+    assert m == L[10:14].min() and m0 == cost[0, 0].min()
+    assert (L[2:6] == cost[0, 0]).all() and (sf[:4] == cost[0, 0]).all() and (sf[4:8] == L[10:14]).all()
+    # the fused four-path step equals four single steps
+    L4 = np.full(8 * 8, agg_mod._SENT, np.uint16)
+    for q in range(4):
+        L4[q * 8 + 2 : q * 8 + 6] = cost[1, q]
+    sa = np.zeros(cf.size, np.uint16)
+    sb = np.zeros(cf.size, np.uint16)
+    mq = [int(cost[1, q].min()) for q in range(4)]
+    qb = [U(q * 8) for q in range(4)]
+    ob = [U(32 + q * 8) for q in range(4)]
+    m4 = agg_mod._step4.py_func(cf, U(8), L4, *qb, *mq, *ob, 60, 300, 310, 320, 330, sa, 4, False)
+    Lb = L4.copy()
+    m1 = [agg_mod._step(cf, U(8), Lb, qb[q], mq[q], ob[q], 0, 60, 300 + 10 * q, sb, 4, False) for q in range(4)]
+    assert list(m4) == m1 and (sa == sb).all() and (L4 == Lb).all()
 
     lev = np.empty((5, 6), np.float32)
     conf = np.empty((5, 6), np.float32)
