@@ -52,7 +52,8 @@ def main() -> None:
     cv2.setNumThreads(2)
     n, nd = args.size, args.disp
     rng = np.random.default_rng(0)
-    print(f"numba threads: {os.environ.get('NUMBA_NUM_THREADS', 'default')}, OpenCV threads: 2, load {os.getloadavg()}")
+    threads = os.environ.get("NUMBA_NUM_THREADS", "default")
+    print(f"numba threads: {threads}, OpenCV threads: 2, load average {os.getloadavg()[0]:.1f}")
 
     # ---------------------------------------------------------------- aggregation
     cost = rng.integers(0, COST_MAX + 1, (n, n, nd), dtype=np.uint16)
@@ -79,9 +80,12 @@ def main() -> None:
     sgbmh.compute(left, right)
     t_hh = time.perf_counter() - t0
     print(f"\naggregation, {n} x {n} cells x {nd} levels (medians of {args.reps} interleaved rounds)")
-    print(f"  TruOrtho aggregate, 8 paths      {_median(t_ours):7.3f} s  {work * 8 / _median(t_ours) / 1e9:6.2f} G/s")
-    print(f"  OpenCV SGBM_3WAY, 3 paths, +cost {_median(t_cv3):7.3f} s  {work * 3 / _median(t_cv3) / 1e9:6.2f} G/s")
-    print(f"  OpenCV HH, 8 paths, +cost (1x)   {t_hh:7.3f} s  {work * 8 / t_hh / 1e9:6.2f} G/s  (1 thread, info)")
+    to, t3 = _median(t_ours), _median(t_cv3)
+    print(f"  TruOrtho aggregate, 8 paths      {to:7.3f} s  {work * 8 / to / 1e9:6.2f} G/s")
+    print(f"  OpenCV SGBM_3WAY, 3 paths, +cost {t3:7.3f} s  {work * 3 / t3 / 1e9:6.2f} G/s")
+    print(
+        f"  OpenCV HH, 8 paths, +cost        {t_hh:7.3f} s  {work * 8 / t_hh / 1e9:6.2f} G/s  (1 thread; info)"
+    )
     print(f"  ratio of throughputs (ours / 3WAY), median per round: {_median(ratios):.2f}")
     del cost
 

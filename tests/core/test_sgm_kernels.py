@@ -555,7 +555,8 @@ def test_kernels_pure_python_on_tiny_inputs(rng):
         lf = np.full((3 * 3 * 6 + 2) * 8, agg_mod._SENT, np.uint16)
         mb = np.zeros((3, 3, 6), np.int64)
         for i0, i1 in ((0, 2), (2, 5)):
-            agg_mod._sweep.py_func(cost, z0, p2, guide, 0.2, 60, S2, agg_mod._DOWN8, down, i0, i1, lf, mb, False)
+            args = (cost, z0, p2, guide, 0.2, 60, S2, agg_mod._DOWN8, down, i0, i1, lf, mb, False)
+            agg_mod._sweep.py_func(*args)
     np.testing.assert_array_equal(S2.astype(np.int64), ref_aggregate(cost, 60, 300, 8, z0, guide, 0.2))
     assert agg_mod._p2_step.py_func(p2, guide, 0.2, 60, 1, 1, 0, 0) >= 61
     U = np.uint64
@@ -565,7 +566,8 @@ def test_kernels_pure_python_on_tiny_inputs(rng):
     m0 = agg_mod._first.py_func(cf, U(0), L, U(0), sf, 4, False)
     m = agg_mod._step.py_func(cf, U(4), L, U(0), m0, U(8), 1, 60, 300, sf, 4, True)
     assert m == L[10:14].min() and m0 == cost[0, 0].min()
-    assert (L[2:6] == cost[0, 0]).all() and (sf[:4] == cost[0, 0]).all() and (sf[4:8] == L[10:14]).all()
+    assert (L[2:6] == cost[0, 0]).all() and (sf[:4] == cost[0, 0]).all()
+    assert (sf[4:8] == L[10:14]).all()
     # the fused four-path step equals four single steps
     L4 = np.full(8 * 8, agg_mod._SENT, np.uint16)
     for q in range(4):
@@ -577,7 +579,9 @@ def test_kernels_pure_python_on_tiny_inputs(rng):
     ob = [U(32 + q * 8) for q in range(4)]
     m4 = agg_mod._step4.py_func(cf, U(8), L4, *qb, *mq, *ob, 60, 300, 310, 320, 330, sa, 4, False)
     Lb = L4.copy()
-    m1 = [agg_mod._step(cf, U(8), Lb, qb[q], mq[q], ob[q], 0, 60, 300 + 10 * q, sb, 4, False) for q in range(4)]
+    m1 = [
+        agg_mod._step(cf, U(8), Lb, qb[q], mq[q], ob[q], 0, 60, 300 + 10 * q, sb, 4, False) for q in range(4)
+    ]
     assert list(m4) == m1 and (sa == sb).all() and (L4 == Lb).all()
 
     lev = np.empty((5, 6), np.float32)
