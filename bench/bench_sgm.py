@@ -83,9 +83,8 @@ def main() -> None:
     to, t3 = _median(t_ours), _median(t_cv3)
     print(f"  TruOrtho aggregate, 8 paths      {to:7.3f} s  {work * 8 / to / 1e9:6.2f} G/s")
     print(f"  OpenCV SGBM_3WAY, 3 paths, +cost {t3:7.3f} s  {work * 3 / t3 / 1e9:6.2f} G/s")
-    print(
-        f"  OpenCV HH, 8 paths, +cost        {t_hh:7.3f} s  {work * 8 / t_hh / 1e9:6.2f} G/s  (1 thread; info)"
-    )
+    hh = work * 8 / t_hh / 1e9
+    print(f"  OpenCV HH, 8 paths, +cost        {t_hh:7.3f} s  {hh:6.2f} G/s  (1 thread; info)")
     print(f"  ratio of throughputs (ours / 3WAY), median per round: {_median(ratios):.2f}")
     del cost
 
