@@ -20,7 +20,9 @@ cells x levels x images per second, per measure.
 
 Both peers run interleaved ``--reps`` times; the medians and the median of
 the per-round ratios are printed. The machine is shared: timings are
-indicative only.
+indicative only. Because wall-clock times on a loaded machine mostly measure
+the scheduler, the same comparison is also made per core: one thread each
+(``numba.set_num_threads(1)``, ``cv2.setNumThreads(1)``) timed by CPU time.
 """
 
 from __future__ import annotations
@@ -86,6 +88,30 @@ def main() -> None:
     hh = work * 8 / t_hh / 1e9
     print(f"  OpenCV HH, 8 paths, +cost        {t_hh:7.3f} s  {hh:6.2f} G/s  (1 thread; info)")
     print(f"  ratio of throughputs (ours / 3WAY), median per round: {_median(ratios):.2f}")
+
+    import numba
+
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    cv2.setNumThreads(1)
+    c_ours, c_cv3, c_ratio = [], [], []
+    for _ in range(args.reps):
+        t0 = time.process_time()
+        S = aggregate(cost)
+        t1 = time.process_time()
+        del S
+        sgbm3.compute(left, right)
+        t2 = time.process_time()
+        c_ours.append(t1 - t0)
+        c_cv3.append(t2 - t1)
+        c_ratio.append((work * 8 / (t1 - t0)) / (work * 3 / (t2 - t1)))
+    numba.set_num_threads(threads)
+    cv2.setNumThreads(2)
+    co, c3 = _median(c_ours), _median(c_cv3)
+    print("  per core (1 thread each, CPU time):")
+    print(f"    TruOrtho aggregate, 8 paths      {co:7.3f} s  {work * 8 / co / 1e9:6.2f} G/s")
+    print(f"    OpenCV SGBM_3WAY, 3 paths, +cost {c3:7.3f} s  {work * 3 / c3 / 1e9:6.2f} G/s")
+    print(f"    ratio (ours / 3WAY), median per round: {_median(c_ratio):.2f}")
     del cost
 
     # ---------------------------------------------------------------- cost
@@ -95,16 +121,27 @@ def main() -> None:
     slices[0, : m // 4, : m // 4] = np.nan
     levels = 8
     print(f"\ncost, {m} x {m} cells x {levels} levels x {k} images")
+    print(f"  {'measure':9s} {'wall':>8s} {'(2 threads)':>28s} {'CPU, 1 thread':>36s}")
     for measure in ("gradient", "ncc", "census"):
         multi_image_cost(slices[:, :32, :32], 2, measure=measure)
-        times = []
+        walls, cpus = [], []
         for _ in range(max(1, args.reps // 2)):
             t0 = time.perf_counter()
             for _lev in range(levels):
                 multi_image_cost(slices, 2, measure=measure)
-            times.append(time.perf_counter() - t0)
-        t = _median(times)
-        print(f"  {measure:9s} {t:7.3f} s  {m * m * levels * k / t / 1e6:8.1f} M cell-level-images/s")
+            walls.append(time.perf_counter() - t0)
+            numba.set_num_threads(1)
+            t0 = time.process_time()
+            for _lev in range(levels):
+                multi_image_cost(slices, 2, measure=measure)
+            cpus.append(time.process_time() - t0)
+            numba.set_num_threads(threads)
+        tw, tc = _median(walls), _median(cpus)
+        rate = m * m * levels * k / 1e6
+        print(
+            f"  {measure:9s} {tw:7.3f} s {rate / tw:8.1f} M cell-level-images/s"
+            f" {tc:7.3f} s {rate / tc:8.1f} M cell-level-images/s"
+        )
 
 
 if __name__ == "__main__":

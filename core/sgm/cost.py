@@ -473,11 +473,24 @@ def _gradients(sl, gx, gy):
             gy[r, c] = _diff1(a, sl[r, c], b)
 
 
+#: Quantisation of the saturated gradients (int16 values in [-Q, Q]).
+_GQ = 127
+#: Largest number of samples the saturation scale (median |g|) is taken from.
+_MEDIAN_SAMPLES = 65536
+
+
 @njit
-def _saturate(g, out):
-    """``clip(g / median|g|, -1, 1)`` over the valid samples (NaN kept); a zero
-    median (mostly flat slice) uses the mean of the non-zero |g| instead."""
-    vals = np.abs(g.ravel())
+def _saturate(g, q, v):
+    """Quantised saturated gradient ``q = round(Q clip(g / median|g|, -1, 1))``
+    (int16) and validity ``v`` (uint8, 0 where ``g`` is NaN, with ``q = 0``).
+
+    The median of |g| is taken over at most ``_MEDIAN_SAMPLES`` valid
+    samples (a regular stride through the slice); a zero median (a mostly
+    flat slice) uses the mean of the non-zero |g| instead.
+    """
+    flat = g.ravel()
+    stride = max(1, flat.size // _MEDIAN_SAMPLES)
+    vals = np.abs(flat[::stride])
     vals = vals[vals == vals]
     scale = 0.0
     if vals.size > 0:
@@ -485,111 +498,122 @@ def _saturate(g, out):
         if scale <= 0.0:
             nz = vals[vals > 0.0]
             scale = nz.mean() if nz.size > 0 else 0.0
+    inv = _GQ / scale if scale > 0.0 else 0.0
     rows, cols = g.shape
     for r in range(rows):
         for c in range(cols):
-            v = g[r, c]
-            if v != v:
-                out[r, c] = np.nan
-            elif scale > 0.0:
-                out[r, c] = min(1.0, max(-1.0, v / scale))
+            x = g[r, c]
+            if x != x:
+                q[r, c] = 0
+                v[r, c] = 0
             else:
-                out[r, c] = 0.0
+                q[r, c] = np.int16(round(min(float(_GQ), max(-float(_GQ), x * inv))))
+                v[r, c] = 1
 
 
 @njit
-def _grad_count(gx, gy, r0, r1, radius, out):
-    """Valid (gx and gy) samples per window for rows ``[r0, r1)``."""
-    rows, cols = gx.shape
-    colsum = np.zeros(cols, np.int64)
+def _need_strip(r0, r1, rows, cols, radius, min_valid, out):
+    """Samples a window needs, per cell of rows ``[r0, r1)`` (see ``_need``)."""
+    for r in range(r0, r1):
+        for c in range(cols):
+            out[r - r0, c] = _need(_window_cells(r, c, rows, cols, radius), min_valid)
+
+
+@njit
+def _grad_count(v, r0, r1, radius, out):
+    """Valid gradient samples per window for rows ``[r0, r1)`` (integer running sums)."""
+    rows, cols = v.shape
+    colsum = np.zeros(cols, np.int32)
     for rr in range(max(0, r0 - radius), min(rows, r0 + radius + 1)):
         for c in range(cols):
-            if gx[rr, c] == gx[rr, c] and gy[rr, c] == gy[rr, c]:
-                colsum[c] += 1
+            colsum[c] += v[rr, c]
     for r in range(r0, r1):
         if r > r0:
             ra = r + radius
             if ra < rows:
                 for c in range(cols):
-                    if gx[ra, c] == gx[ra, c] and gy[ra, c] == gy[ra, c]:
-                        colsum[c] += 1
+                    colsum[c] += v[ra, c]
             rs = r - radius - 1
             if rs >= 0:
                 for c in range(cols):
-                    if gx[rs, c] == gx[rs, c] and gy[rs, c] == gy[rs, c]:
-                        colsum[c] -= 1
-        acc = 0
-        for c in range(min(cols, radius + 1)):
-            acc += colsum[c]
-        for c in range(cols):
-            if c > 0:
-                if c + radius < cols:
-                    acc += colsum[c + radius]
-                if c - radius - 1 >= 0:
-                    acc -= colsum[c - radius - 1]
-            out[r - r0, c] = acc
+                    colsum[c] -= v[rs, c]
+        _hsum_i(colsum, radius, out[r - r0])
 
 
 @njit
-def _grad_pair(ax, ay, bx, by, r0, r1, radius, dsum, dcnt):
-    """Window sums of ``(|ax - bx| + |ay - by|) / 2`` and of the count over the
-    samples valid in both images, rows ``[r0, r1)``."""
+def _hsum_i(colsum, radius, out):
+    """Running horizontal window sums of an int32 row."""
+    cols = colsum.shape[0]
+    acc = np.int32(0)
+    for c in range(min(cols, radius + 1)):
+        acc += colsum[c]
+    for c in range(cols):
+        if c > 0:
+            if c + radius < cols:
+                acc += colsum[c + radius]
+            if c - radius - 1 >= 0:
+                acc -= colsum[c - radius - 1]
+        out[c] = acc
+
+
+@njit
+def _grad_row(ax, ay, av, bx, by, bv, rr, dsum, dcnt, sign):
+    """Adds (sign +1) or removes (-1) row ``rr`` of a pair to the column sums:
+    ``|ax - bx| + |ay - by|`` and the count over the samples valid in both
+    (branch-free: invalid samples have q = 0 and v = 0)."""
+    cols = ax.shape[1]
+    for c in range(cols):
+        m = np.int32(av[rr, c] & bv[rr, c])
+        d = abs(np.int32(ax[rr, c]) - np.int32(bx[rr, c])) + abs(np.int32(ay[rr, c]) - np.int32(by[rr, c]))
+        dsum[c] += sign * d * m
+        dcnt[c] += sign * m
+
+
+@njit
+def _grad_pair(ax, ay, av, bx, by, bv, r0, r1, radius, need, cnta, cntb, out):
+    """Pair contributions ``min(1, mean (|dgx| + |dgy|) / 2)`` for rows ``[r0, r1)``
+    into ``out`` (NaN where fewer than ``need`` common samples or views)."""
     rows, cols = ax.shape
-    cs = np.zeros(cols, np.float64)
-    cn = np.zeros(cols, np.int64)
+    ds = np.zeros(cols, np.int32)
+    dc = np.zeros(cols, np.int32)
+    hs = np.empty(cols, np.int32)
+    hc = np.empty(cols, np.int32)
     for rr in range(max(0, r0 - radius), min(rows, r0 + radius + 1)):
-        for c in range(cols):
-            v = 0.5 * (abs(ax[rr, c] - bx[rr, c]) + abs(ay[rr, c] - by[rr, c]))
-            if v == v:
-                cs[c] += v
-                cn[c] += 1
+        _grad_row(ax, ay, av, bx, by, bv, rr, ds, dc, 1)
+    scale = 1.0 / (2.0 * _GQ)
     for r in range(r0, r1):
         if r > r0:
-            ra = r + radius
-            if ra < rows:
-                for c in range(cols):
-                    v = 0.5 * (abs(ax[ra, c] - bx[ra, c]) + abs(ay[ra, c] - by[ra, c]))
-                    if v == v:
-                        cs[c] += v
-                        cn[c] += 1
-            rs = r - radius - 1
-            if rs >= 0:
-                for c in range(cols):
-                    v = 0.5 * (abs(ax[rs, c] - bx[rs, c]) + abs(ay[rs, c] - by[rs, c]))
-                    if v == v:
-                        cs[c] -= v
-                        cn[c] -= 1
-        acc = 0.0
-        acn = 0
-        for c in range(min(cols, radius + 1)):
-            acc += cs[c]
-            acn += cn[c]
+            if r + radius < rows:
+                _grad_row(ax, ay, av, bx, by, bv, r + radius, ds, dc, 1)
+            if r - radius - 1 >= 0:
+                _grad_row(ax, ay, av, bx, by, bv, r - radius - 1, ds, dc, -1)
+        _hsum_i(ds, radius, hs)
+        _hsum_i(dc, radius, hc)
+        i = r - r0
         for c in range(cols):
-            if c > 0:
-                if c + radius < cols:
-                    acc += cs[c + radius]
-                    acn += cn[c + radius]
-                if c - radius - 1 >= 0:
-                    acc -= cs[c - radius - 1]
-                    acn -= cn[c - radius - 1]
-            dsum[r - r0, c] = acc
-            dcnt[r - r0, c] = acn
+            k = need[i, c]
+            if hc[c] >= k and cnta[i, c] >= k and cntb[i, c] >= k:
+                out[i, c] = min(1.0, hs[c] * scale / hc[c])
+            else:
+                out[i, c] = np.nan
 
 
 @pjit
-def _prep_gradients(sl, gx, gy):
+def _prep_gradients(sl, qx, qy, vv):
     n = sl.shape[0]
-    tx = np.empty(sl.shape, np.float32)
-    ty = np.empty(sl.shape, np.float32)
     for i in prange(n):
-        _gradients(sl[i], tx[i], ty[i])
-        _saturate(tx[i], gx[i])
-        _saturate(ty[i], gy[i])
+        tx = np.empty(sl.shape[1:], np.float32)
+        ty = np.empty(sl.shape[1:], np.float32)
+        _gradients(sl[i], tx, ty)
+        vx = np.empty(sl.shape[1:], np.uint8)
+        _saturate(tx, qx[i], vx)
+        _saturate(ty, qy[i], vv[i])
+        vv[i] &= vx
 
 
 @pjit
-def _mic_grad_kernel(gx, gy, radius, min_valid, best_k, strip, cost_out, nv_out):
-    n, rows, cols = gx.shape
+def _mic_grad_kernel(qx, qy, vv, radius, min_valid, best_k, strip, cost_out, nv_out):
+    n, rows, cols = qx.shape
     npairs = n * (n - 1) // 2
     cmax = np.float64(COST_MAX)
     nstrips = (rows + strip - 1) // strip
@@ -597,40 +621,39 @@ def _mic_grad_kernel(gx, gy, radius, min_valid, best_k, strip, cost_out, nv_out)
         r0 = s * strip
         r1 = min(rows, r0 + strip)
         h = r1 - r0
-        cnt = np.empty((n, h, cols), np.int64)
+        need = np.empty((h, cols), np.int64)
+        _need_strip(r0, r1, rows, cols, radius, min_valid, need)
+        cnt = np.empty((n, h, cols), np.int32)
         for i in range(n):
-            _grad_count(gx[i], gy[i], r0, r1, radius, cnt[i])
+            _grad_count(vv[i], r0, r1, radius, cnt[i])
         pc = np.empty((npairs, h, cols), np.float32)
-        dsum = np.empty((h, cols), np.float64)
-        dcnt = np.empty((h, cols), np.int64)
         p = 0
         for i in range(n):
             for j in range(i + 1, n):
-                _grad_pair(gx[i], gy[i], gx[j], gy[j], r0, r1, radius, dsum, dcnt)
-                for a in range(h):
-                    for c in range(cols):
-                        need = _need(_window_cells(r0 + a, c, rows, cols, radius), min_valid)
-                        if dcnt[a, c] >= need and cnt[i, a, c] >= need and cnt[j, a, c] >= need:
-                            pc[p, a, c] = min(1.0, dsum[a, c] / dcnt[a, c])
-                        else:
-                            pc[p, a, c] = np.nan
+                _grad_pair(
+                    qx[i], qy[i], vv[i], qx[j], qy[j], vv[j], r0, r1, radius, need, cnt[i], cnt[j], pc[p]
+                )
                 p += 1
         col = np.empty(max(1, npairs), np.float32)
         buf = np.empty(max(1, npairs), np.float32)
         for a in range(h):
             for c in range(cols):
-                need = _need(_window_cells(r0 + a, c, rows, cols, radius), min_valid)
+                k = need[a, c]
                 nv = 0
                 for i in range(n):
-                    if cnt[i, a, c] >= need:
+                    if cnt[i, a, c] >= k:
                         nv += 1
                 nv_out[r0 + a, c] = nv
                 if nv < 2:
                     cost_out[r0 + a, c] = COST_MAX
                     continue
-                for q in range(npairs):
-                    col[q] = pc[q, a, c]
-                m = _combine(col, npairs, nv, best_k, buf)
+                if npairs == 1:
+                    m = pc[0, a, c]
+                    m = -1.0 if m != m else m
+                else:
+                    for q in range(npairs):
+                        col[q] = pc[q, a, c]
+                    m = _combine(col, npairs, nv, best_k, buf)
                 if m < 0.0:
                     cost_out[r0 + a, c] = COST_MAX
                 else:
@@ -700,7 +723,11 @@ def multi_image_cost(
     slices : (n, rows, cols) float array
         The n images sampled at the cells of one grid (for OSGM: at the cell
         centres of one plane Z = const), NaN where an image does not see the
-        cell. ``2 <= n <= 255``.
+        cell. ``2 <= n <= 255``. Several planes may be stacked along the rows
+        in one call (fewer calls, and for ``"gradient"`` one saturation scale
+        per image for all of them) if the cells read from each plane are at
+        least ``radius`` rows (``radius + 1`` for ``"gradient"``, whose row
+        derivative looks one row further) away from the plane's edges.
     radius : int
         Window radius ``r`` (windows of ``(2 r + 1)^2`` cells).
     best_k : int or None
@@ -762,10 +789,11 @@ def multi_image_cost(
             raise InputError(f"out: expected ({shape} uint16, {shape} uint8) arrays")
     # kernels write through strided views too
     if measure == "gradient":
-        gx = np.empty(s.shape, np.float32)
-        gy = np.empty(s.shape, np.float32)
-        _prep_gradients(np.ascontiguousarray(s), gx, gy)
-        _mic_grad_kernel(gx, gy, radius, min_valid, k, _STRIP, cost, nv)
+        qx = np.empty(s.shape, np.int16)
+        qy = np.empty(s.shape, np.int16)
+        vv = np.empty(s.shape, np.uint8)
+        _prep_gradients(np.ascontiguousarray(s), qx, qy, vv)
+        _mic_grad_kernel(qx, qy, vv, radius, min_valid, k, _STRIP, cost, nv)
     elif measure == "ncc":
         z, vf = _prepare(s)
         _mic_ncc_kernel(z, vf, radius, min_valid, k, _STRIP, cost, nv)

@@ -55,6 +55,9 @@ def disparity_costs(
     h, w = left.shape
     cost = np.empty((h, w, num_disp), np.uint16)
     nv = np.empty((h, w), np.uint8)
+    if measure == "gradient" and border == "replicate":
+        _gradient_costs(left, right, min_disp, num_disp, radius, min_valid, cost, nv, progress)
+        return cost
     pair = np.empty((2, h, w), np.float32)
     pair[0] = left
     xs = np.arange(w)
@@ -74,6 +77,42 @@ def disparity_costs(
         if progress is not None:
             progress.update(0.5 * (k + 1) / num_disp, "matching costs")
     return cost
+
+
+def _gradient_costs(left, right, min_disp, num_disp, radius, min_valid, cost, nv, progress) -> None:
+    """The gradient measure's cost kernel per disparity, each image prepared once.
+
+    The preparation of :func:`~.cost.multi_image_cost` (gradients, saturation
+    at the median |g|) runs once on the left image and once on the right image
+    extended by replicated border columns; each disparity then runs the cost
+    kernel on the left preparation and the shifted right one. This equals
+    per-slice calls except that the saturation scale is the whole image's
+    (not each shifted slice's) and the slice edges use the extended image's
+    central differences.
+    """
+    from .cost import _STRIP, _mic_grad_kernel, _prep_gradients
+
+    h, w = left.shape
+    lo = max(0, min_disp + num_disp - 1)  # columns added left of the right image
+    hi = max(0, -min_disp)  # and right of it
+    ext = np.concatenate([np.repeat(right[:, :1], lo, axis=1), right, np.repeat(right[:, -1:], hi, axis=1)], axis=1)
+    ql = [np.empty((1, h, w), np.int16) for _ in range(2)] + [np.empty((1, h, w), np.uint8)]
+    _prep_gradients(left[None], ql[0], ql[1], ql[2])
+    qr = [np.empty((1, h, ext.shape[1]), np.int16) for _ in range(2)] + [np.empty((1, h, ext.shape[1]), np.uint8)]
+    _prep_gradients(np.ascontiguousarray(ext[None]), qr[0], qr[1], qr[2])
+    pair = [np.empty((2, h, w), a.dtype) for a in ql]
+    for a, b in zip(pair, ql, strict=True):
+        a[0] = b[0]
+    c = np.empty((h, w), np.uint16)
+    for k in range(num_disp):
+        check(progress)
+        x0 = lo - (min_disp + k)  # right_d[:, x] = ext[:, x0 + x]
+        for a, b in zip(pair, qr, strict=True):
+            a[1] = b[0, :, x0 : x0 + w]
+        _mic_grad_kernel(pair[0], pair[1], pair[2], radius, min_valid, 0, _STRIP, c, nv)
+        cost[:, :, k] = c
+        if progress is not None:
+            progress.update(0.5 * (k + 1) / num_disp, "matching costs")
 
 
 def match_rectified(
