@@ -95,10 +95,11 @@ def _gradient_costs(left, right, min_disp, num_disp, radius, min_valid, cost, nv
     h, w = left.shape
     lo = max(0, min_disp + num_disp - 1)  # columns added left of the right image
     hi = max(0, -min_disp)  # and right of it
-    ext = np.concatenate([np.repeat(right[:, :1], lo, axis=1), right, np.repeat(right[:, -1:], hi, axis=1)], axis=1)
+    ext = np.concatenate([np.repeat(right[:, :1], lo, 1), right, np.repeat(right[:, -1:], hi, 1)], axis=1)
+    we = ext.shape[1]
     ql = [np.empty((1, h, w), np.int16) for _ in range(2)] + [np.empty((1, h, w), np.uint8)]
     _prep_gradients(left[None], ql[0], ql[1], ql[2])
-    qr = [np.empty((1, h, ext.shape[1]), np.int16) for _ in range(2)] + [np.empty((1, h, ext.shape[1]), np.uint8)]
+    qr = [np.empty((1, h, we), np.int16) for _ in range(2)] + [np.empty((1, h, we), np.uint8)]
     _prep_gradients(np.ascontiguousarray(ext[None]), qr[0], qr[1], qr[2])
     pair = [np.empty((2, h, w), a.dtype) for a in ql]
     for a, b in zip(pair, ql, strict=True):
