@@ -625,3 +625,32 @@ def test_rectified_costs_equal_per_slice_calls(rng):
     assert np.abs(fast[inner].astype(int) - slow[inner]).max() <= 0.1 * COST_MAX  # only the scale differs
     assert (np.argmin(fast[inner], axis=2) == np.argmin(slow[inner], axis=2)).mean() > 0.97
     assert (np.argmin(fast[inner], axis=2) == 5).mean() > 0.9  # d = 3 is level 5
+
+
+def test_match_rectified_options_on_a_random_dot_pair(rng):
+    from truortho.core.sgm import match_rectified
+
+    tex = rng.random((40, 90))
+    left = (255 * tex[:, 10:80]).astype(np.uint8)
+    right = (200 * tex[:, 16:86] + 20).astype(np.uint8)  # disparity 6, other gain and offset
+    colour = np.repeat(left[:, :, None], 3, axis=2)
+    d = match_rectified(colour, right, 0, 12)
+    inner = np.s_[3:-3, 12:-3]
+    assert d.dtype == np.float32 and d.shape == left.shape
+    assert (np.abs(d[inner] - 6) < 0.5).mean() > 0.97
+    d_lr = match_rectified(left, right, 0, 12, lr_check=1.0)
+    assert (np.abs(d_lr[inner] - 6) < 0.5).mean() > 0.95
+    assert np.isnan(d_lr).sum() >= np.isnan(d).sum()
+    d_nan = match_rectified(left, right, 4, 8, border="nan", median=1)
+    assert np.isnan(d_nan[:, :2]).all()  # with d >= 4 these columns' windows lie outside the right image
+    assert (np.abs(d_nan[inner] - 6) < 0.5).mean() > 0.97
+    d16 = match_rectified(left.astype(np.uint16) * 257, right, 0, 12, measure="ncc", paths=16, adaptive=False)
+    assert (np.abs(d16[inner] - 6) < 0.5).mean() > 0.95
+    with pytest.raises(InputError, match="right"):
+        match_rectified(left, right[:, :-1], 0, 12)
+    with pytest.raises(InputError, match="num_disp"):
+        match_rectified(left, right, 0, 0)
+    with pytest.raises(InputError, match="median"):
+        match_rectified(left, right, 0, 12, median=2)
+    with pytest.raises(InputError, match="border"):
+        match_rectified(left, right, 0, 12, border="wrap")
