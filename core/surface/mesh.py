@@ -50,6 +50,7 @@ from ..errors import InputError
 from ..grid import RasterGrid
 from ..jit import njit
 from ..progress import Progress, as_progress, check
+from ._raster import colours_on_grid
 from .meshio import Mesh
 
 
@@ -855,25 +856,10 @@ def mesh_from_dsm(
             data, _, _ = read_raster(path, 1, (a0, b0, a1 - a0, b1 - b0))
             out[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0] = data
         if ortho_grid is not None:
-            col = _colours_on_grid(ortho_path, grid.window(r0, c0, nr, nc), ortho_grid)
+            col = colours_on_grid(ortho_path, grid.window(r0, c0, nr, nc), ortho_grid)
         return out, col
 
     return _mesh_tiles(read, grid, cfg, ortho_path is not None, progress)
-
-
-def _colours_on_grid(ortho_path, grid: RasterGrid, ortho_grid: RasterGrid) -> np.ndarray:
-    """(rows, cols, 3) float colours of an orthoimage on ``grid`` (0 where it has no data)."""
-    from ..rasterio_io import read_onto_grid
-
-    resampling = "average" if ortho_grid.res < 0.75 * grid.res else "bilinear"
-    bands = []
-    for b in (1, 2, 3):
-        try:
-            bands.append(read_onto_grid(ortho_path, grid, band=b, resampling=resampling))
-        except InputError:
-            bands.append(bands[0] if bands else np.zeros(grid.shape, np.float32))
-    out = np.stack(bands, axis=-1).astype(np.float64)
-    return np.nan_to_num(out, nan=0.0)
 
 
 # ------------------------------------------------------------------ mesh -> raster
@@ -927,3 +913,103 @@ def rasterize_mesh(mesh: Mesh, grid: RasterGrid) -> np.ndarray:
     out = np.full(grid.shape, np.nan)
     _raster_faces(mesh.vertices, mesh.faces, grid.x_min, grid.y_max, grid.res, grid.rows, grid.cols, out)
     return out
+
+
+# ------------------------------------------------------------------ point cloud -> mesh
+
+
+def mesh_from_point_cloud(
+    cloud, max_edge: float | None = None, max_angle_deg: float = 80.0, progress: Progress | None = None
+) -> Mesh:
+    """A mesh of a (merged, oblique) point cloud: one 2.5D Delaunay mesh per reference system.
+
+    For every reference system the points are projected onto the plane normal to its
+    viewing direction (``ReferenceSystem.view_direction``; nadir ``(0, 0, -1)`` when
+    unknown) and triangulated (Delaunay, scipy); triangles with an edge longer than
+    ``max_edge`` (default 4 x the median nearest-neighbour spacing) or seen at more
+    than ``max_angle_deg`` from the viewing direction (they would bridge depth
+    discontinuities) are dropped. The meshes of the systems are concatenated: where
+    two systems see the same surface their layers overlap (no fusion), and the mesh is
+    not watertight. Faces face the cameras of their system.
+
+    Parameters
+    ----------
+    cloud : PointCloud
+        See :mod:`.pointcloud`; ``system`` ids select the systems (all one system when absent).
+
+    Returns
+    -------
+    Mesh
+        World coordinates, vertex colours when the cloud has them.
+    """
+    from scipy.spatial import Delaunay, cKDTree
+
+    from .pointcloud import PointCloud
+
+    if not isinstance(cloud, PointCloud):
+        raise InputError(f"expected a PointCloud, got {type(cloud).__name__}")
+    if len(cloud) < 3:
+        raise InputError(f"a mesh needs at least 3 points, the cloud has {len(cloud)}")
+    if not 1.0 <= max_angle_deg < 90.0:
+        raise InputError(f"max_angle_deg must lie in [1, 90), got {max_angle_deg!r}")
+    prog = as_progress(progress)
+    sys_ids = cloud.system if cloud.system is not None else np.zeros(len(cloud), np.uint16)
+    dirs = {s.id: s.view_direction for s in cloud.systems}
+    verts, faces, cols = [], [], []
+    base = 0
+    ids = np.unique(sys_ids)
+    cos_max = math.cos(math.radians(max_angle_deg))
+    for n, sid in enumerate(ids):
+        check(prog)
+        idx = np.nonzero(sys_ids == sid)[0]
+        if len(idx) < 3:
+            continue
+        v = np.asarray(dirs.get(int(sid)) or (0.0, 0.0, -1.0), dtype=np.float64)
+        if not np.all(np.isfinite(v)) or np.linalg.norm(v) == 0:
+            raise InputError(f"reference system {int(sid)}: invalid view direction {v.tolist()}")
+        v = v / np.linalg.norm(v)
+        a = np.array([1.0, 0.0, 0.0]) if abs(v[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        e1 = np.cross(v, a)
+        e1 /= np.linalg.norm(e1)
+        e2 = np.cross(v, e1)
+        p = cloud.xyz[idx]
+        centre = p.mean(axis=0)
+        q = np.column_stack([(p - centre) @ e1, (p - centre) @ e2])
+        try:
+            tri = Delaunay(q).simplices.astype(np.int64)
+        except Exception as exc:  # degenerate (collinear) input
+            raise InputError(
+                f"reference system {int(sid)}: the points cannot be triangulated ({exc})"
+            ) from None
+        edge = max_edge
+        if edge is None:
+            d, _ = cKDTree(q).query(q, k=2)
+            edge = 4.0 * float(np.median(d[:, 1]))
+        A, B, C = p[tri[:, 0]], p[tri[:, 1]], p[tri[:, 2]]
+        longest = np.max(
+            np.stack(
+                [np.linalg.norm(B - A, axis=1), np.linalg.norm(C - B, axis=1), np.linalg.norm(A - C, axis=1)]
+            ),
+            axis=0,
+        )
+        nrm = np.cross(B - A, C - A)
+        nn = np.linalg.norm(nrm, axis=1)
+        facing = -(nrm @ v) / np.where(nn > 0, nn, 1.0)
+        keep = (longest <= edge) & (np.abs(facing) >= cos_max) & (nn > 0)
+        t = tri[keep]
+        flip = facing[keep] < 0
+        t[flip] = t[flip][:, [0, 2, 1]]
+        used = np.unique(t)
+        remap = -np.ones(len(p), np.int64)
+        remap[used] = np.arange(len(used))
+        verts.append(p[used])
+        faces.append(remap[t] + base)
+        if cloud.rgb is not None:
+            cols.append(cloud.rgb[idx][used])
+        base += len(used)
+        prog.update((n + 1) / len(ids), f"meshing reference system {int(sid)}")
+    if base == 0:
+        raise InputError("no triangle of the point cloud passed the edge-length and angle tests")
+    return Mesh(
+        np.concatenate(verts), np.concatenate(faces), np.concatenate(cols) if cols else None, cloud.crs
+    )
