@@ -32,8 +32,8 @@ def test_dtm_matches_the_terrain(scene):
     dtm, stats = dtm_from_dsm_array(z, grid)
     e = dtm - terrain
     rmse, open_rmse, under = (float(np.sqrt(np.mean(e[m] ** 2))) for m in (fd >= 0, fd > 2, fd == 0))
-    print(f"\nDTM of the truth DSM: RMSE {rmse:.3f} m (open ground {open_rmse:.3f}, under buildings {under:.3f}); "
-          f"{stats.as_dict()}")
+    print(f"\nDTM of the truth DSM: RMSE {rmse:.3f} m (open ground {open_rmse:.3f}, "
+          f"under buildings {under:.3f}); {stats.as_dict()}")
     assert open_rmse < 0.02 and under < 0.15 and rmse < 0.05
     building_share = float(np.mean(fd == 0))
     assert abs((1 - stats.ground_fraction) - building_share) < 0.03

@@ -61,8 +61,8 @@ def test_flat_roof_acceptance(flat_scene):
     err = top - z
     rmse = float(np.sqrt(np.mean(err**2)))
     ratio = mesh.n_vertices / z.size
-    print(f"\nmesh of {z.size} cells: {mesh.n_vertices} vertices ({ratio:.4f} per cell), {mesh.n_faces} faces "
-          f"({res.wall_faces} wall), vertical RMSE {rmse:.4f} m = {rmse / GSD:.3f} GSD, "
+    print(f"\nmesh of {z.size} cells: {mesh.n_vertices} vertices ({ratio:.4f} per cell), "
+          f"{mesh.n_faces} faces ({res.wall_faces} wall), vertical RMSE {rmse:.4f} m = {rmse / GSD:.3f} GSD, "
           f"max {np.abs(err).max():.4f} m; leaves {res.leaves}")
     assert not np.isnan(top).any()
     assert rmse <= 0.5 * GSD and np.abs(err).max() <= 0.5 * GSD + 1e-9
