@@ -140,6 +140,11 @@ class Mesh:
 # ------------------------------------------------------------------ writing
 
 
+def check_mesh_path(path, what: str = "mesh") -> Path:
+    """``path`` as a Path if it ends in .ply or .obj, else :class:`InputError` naming it."""
+    return _check_path(path, what)
+
+
 def _check_path(path, what: str = "mesh") -> Path:
     p = Path(os.fspath(path))
     if p.suffix.lower() not in MESH_EXTENSIONS:
