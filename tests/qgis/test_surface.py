@@ -33,8 +33,12 @@ def rasters(tmp_path_factory):
     d = degrade_dsm(truth, RES, seed=3)
     rgb, _ = scene.orthophoto(RES, extent=(499960.0, 5599960.0, 500040.0, 5600030.0))
     root = tmp_path_factory.mktemp("surface")
-    write_raster(root / "raw.tif", np.where(np.isfinite(d.dsm), d.dsm, -9999.0).astype(np.float32), grid,
-                 nodata=-9999.0)
+    write_raster(
+        root / "raw.tif",
+        np.where(np.isfinite(d.dsm), d.dsm, -9999.0).astype(np.float32),
+        grid,
+        nodata=-9999.0,
+    )
     write_raster(root / "conf.tif", d.confidence, grid)
     write_raster(root / "truth.tif", truth, grid, nodata=-9999.0)
     write_raster(root / "ortho.tif", np.moveaxis(np.maximum(rgb, 1), -1, 0), grid, nodata=0)
@@ -57,8 +61,11 @@ def test_dsmfilter_with_dtm(truortho_provider, rasters, tmp_path):
         },
     )
     stats = json.loads(res["STATISTICS"])
-    assert res["OUTLIERS_REMOVED"] == stats["filter"]["outliers_removed"] + stats["filter"][
-        "low_confidence_removed"] > 0
+    assert (
+        res["OUTLIERS_REMOVED"]
+        == stats["filter"]["outliers_removed"] + stats["filter"]["low_confidence_removed"]
+        > 0
+    )
     assert res["CELLS_FILLED"] >= int(d.holes.sum()) and res["HOLES_REMAINING"] == 0
     out, g, nodata = read_raster(res["OUTPUT"])
     assert g == grid and nodata == -9999.0
@@ -78,8 +85,12 @@ def test_mesh_from_dsm_for_trueortho(truortho_provider, rasters, tmp_path):
     root, grid, truth, _ = rasters
     res = run(
         "truortho:mesh",
-        {"INPUT": str(root / "truth.tif"), "ORTHO": str(root / "ortho.tif"), "FRAME": 1,
-         "OUTPUT": str(tmp_path / "m.ply")},
+        {
+            "INPUT": str(root / "truth.tif"),
+            "ORTHO": str(root / "ortho.tif"),
+            "FRAME": 1,
+            "OUTPUT": str(tmp_path / "m.ply"),
+        },
     )
     mesh = read_mesh(res["OUTPUT"])
     assert mesh.n_vertices == res["VERTICES"] and mesh.n_faces == res["FACES"] and res["WALL_FACES"] > 0
@@ -97,8 +108,13 @@ def test_point_cloud_ept_opens_in_qgis(truortho_provider, rasters, tmp_path):
     root, grid, truth, _ = rasters
     res = run(
         "truortho:dsmtopointcloud",
-        {"INPUT": str(root / "truth.tif"), "ORTHO": str(root / "ortho.tif"), "CONFIDENCE": str(root / "conf.tif"),
-         "OUTPUT": str(tmp_path / "pc.laz"), "EPT": str(tmp_path / "pc_ept")},
+        {
+            "INPUT": str(root / "truth.tif"),
+            "ORTHO": str(root / "ortho.tif"),
+            "CONFIDENCE": str(root / "conf.tif"),
+            "OUTPUT": str(tmp_path / "pc.laz"),
+            "EPT": str(tmp_path / "pc_ept"),
+        },
     )
     n = truth.size
     assert res["POINTS"] == n
@@ -120,8 +136,12 @@ def test_point_cloud_ept_opens_in_qgis(truortho_provider, rasters, tmp_path):
     # merging with a second "system" (the same cloud, shifted) and thinning
     res2 = run(
         "truortho:mergepointclouds",
-        {"INPUTS": [res["OUTPUT"], res["OUTPUT"]], "VOXEL": 0.1, "OUTPUT": str(tmp_path / "merged.laz"),
-         "EPT": str(tmp_path / "merged_ept")},
+        {
+            "INPUTS": [res["OUTPUT"], res["OUTPUT"]],
+            "VOXEL": 0.1,
+            "OUTPUT": str(tmp_path / "merged.laz"),
+            "EPT": str(tmp_path / "merged_ept"),
+        },
     )
     assert res2["POINTS"] == n  # exact duplicates: one per voxel
     assert QgsPointCloudLayer(res2["EPT_JSON"], "m", "ept").pointCount() == n
