@@ -415,14 +415,20 @@ def _hole_width(nodata: np.ndarray) -> np.ndarray:
 _FOUR = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], bool)
 
 
-def _fill_holes(z: np.ndarray, fill: np.ndarray, step: float, reach: int) -> np.ndarray:
+def _fill_holes(z: np.ndarray, fill: np.ndarray, step: float, reach: int,
+                hint: np.ndarray | None = None) -> np.ndarray:
     """Harmonic interpolation of the cells ``fill`` (nodata) from their valid 4-neighbours.
 
     Each connected component is solved with Dirichlet values on its valid boundary
     cells, except boundary cells more than ``step`` above the lowest boundary cell of
     the same hole within ``reach`` cells (the top of a wall beside an occlusion hole;
     a local rule, so that tiles agree): those are zero-flux, as the window border is. A component
-    left without any Dirichlet cell keeps all its boundary cells. Returns a filled copy.
+    left without any Dirichlet cell keeps all its boundary cells.
+
+    ``hint`` (the raw heights, NaN where the input had no data): a cell removed by the
+    filter whose raw height is closer to the interpolation from the dropped (upper)
+    boundary cells than to the lower one takes the upper one (a blurred roof edge next to
+    an occlusion hole belongs to the roof). Returns a filled copy.
     """
     from scipy import ndimage
 
@@ -432,6 +438,7 @@ def _fill_holes(z: np.ndarray, fill: np.ndarray, step: float, reach: int) -> np.
     labels, _ = ndimage.label(fill, structure=_FOUR)
     valid = np.isfinite(z)
     allowed = valid.copy()
+    upper = np.zeros(z.shape, bool)
     nr, nc = z.shape
     for k, box in enumerate(ndimage.find_objects(labels), start=1):
         if box is None:
@@ -448,6 +455,7 @@ def _fill_holes(z: np.ndarray, fill: np.ndarray, step: float, reach: int) -> np.
         low = ndimage.minimum_filter(np.where(ring, zs, np.inf), size=2 * reach + 1, mode="nearest")
         drop = ring & (zs > low + step)
         allowed[r0:r1, c0:c1] &= ~drop
+        upper[r0:r1, c0:c1] |= drop
     # components whose whole boundary was dropped use every valid neighbour
     ring_all = ndimage.binary_dilation(fill, structure=_FOUR) & valid
     touched = ndimage.binary_dilation(ring_all & allowed, structure=_FOUR) & fill
@@ -456,7 +464,16 @@ def _fill_holes(z: np.ndarray, fill: np.ndarray, step: float, reach: int) -> np.
     orphan = fill & ~has_d[labels]
     if orphan.any():
         allowed |= ndimage.binary_dilation(orphan, structure=_FOUR) & valid
-    return _solve(out, fill, labels, valid, allowed)
+    low_fill = _solve(out, fill, labels, valid, allowed)
+    if hint is None or not upper.any():
+        return low_fill
+    hinted = fill & np.isfinite(hint)
+    if not hinted.any():
+        return low_fill
+    high_fill = _solve(z.copy(), fill, labels, valid, upper)
+    take = hinted & np.isfinite(high_fill) & (np.abs(hint - high_fill) < np.abs(hint - low_fill))
+    low_fill[take] = high_fill[take]
+    return low_fill
 
 
 def _solve(out, fill, labels, valid, allowed):
@@ -666,7 +683,7 @@ def _run(
             wl, _ = ndimage.label(nodata, structure=_FOUR)
             seed_labels = np.unique(wl[sl][core_fill])
             fill = np.isin(wl, seed_labels[seed_labels > 0])
-        filled = _fill_holes(clean, fill, cfg.step, max(hole_cells, 1)) if fill.any() else clean
+        filled = _fill_holes(clean, fill, cfg.step, max(hole_cells, 1), z) if fill.any() else clean
         if cfg.smooth:
             smoothed, changed = _smooth(filled, cfg, res)
             stats.smoothed += int(changed[sl].sum())
