@@ -40,8 +40,10 @@ def test_filtered_dsm_is_closer_to_the_truth(scene_dsm):
     rmse, share = _score(out, truth)
     rmse_common = _score(out, truth, np.isfinite(d.dsm))[0]
     print(f"\nraw DSM: RMSE {raw_rmse:.3f} m, {100 * raw_share:.2f} % of all cells within 3 GSD")
-    print(f"filtered: RMSE {rmse:.3f} m ({rmse_common:.3f} m on the raw DSM's valid cells), "
-          f"{100 * share:.2f} % within 3 GSD; {stats.summary()}")
+    print(
+        f"filtered: RMSE {rmse:.3f} m ({rmse_common:.3f} m on the raw DSM's valid cells), "
+        f"{100 * share:.2f} % within 3 GSD; {stats.summary()}"
+    )
     assert rmse < 0.5 * raw_rmse and rmse_common < 0.5 * raw_rmse
     assert share > raw_share + 0.01
     # away from the (blurred) building edges the filter removes the outliers' error almost entirely
@@ -160,8 +162,9 @@ def test_files_keep_crs_nodata_grid_and_bad_input(tmp_path, scene_dsm):
     raw = np.where(np.isfinite(d.dsm), d.dsm, -9999.0).astype(np.float32)
     write_raster(tmp_path / "raw.tif", raw, grid, nodata=-9999.0)
     write_raster(tmp_path / "conf.tif", d.confidence, grid, nodata=None)
-    stats = filter_dsm(tmp_path / "raw.tif", tmp_path / "out.tif", tmp_path / "conf.tif",
-                       DsmFilterConfig(tile=256))
+    stats = filter_dsm(
+        tmp_path / "raw.tif", tmp_path / "out.tif", tmp_path / "conf.tif", DsmFilterConfig(tile=256)
+    )
     g = raster_grid(tmp_path / "out.tif")
     assert g == grid
     out, _, nodata = read_raster(tmp_path / "out.tif")
@@ -183,3 +186,36 @@ def test_files_keep_crs_nodata_grid_and_bad_input(tmp_path, scene_dsm):
     with pytest.raises(InputError, match="outlier_window"):
         filter_dsm_array(d.dsm, grid, config=DsmFilterConfig(outlier_window=4))
     assert not (tmp_path / "x.tif").exists()
+
+
+def test_cancel_leaves_no_output(tmp_path, scene_dsm):
+    from truortho.core.errors import CancelledError
+    from truortho.core.progress import CallbackProgress
+    from truortho.core.surface.dtm import dtm_from_dsm
+
+    _, _, grid, d = scene_dsm
+    write_raster(
+        tmp_path / "raw.tif", np.nan_to_num(d.dsm, nan=-9999.0).astype(np.float32), grid, nodata=-9999.0
+    )
+    calls = []
+
+    def cancelled():
+        calls.append(1)
+        return len(calls) > 3
+
+    with pytest.raises(CancelledError):
+        filter_dsm(
+            tmp_path / "raw.tif",
+            tmp_path / "out.tif",
+            config=DsmFilterConfig(tile=128),
+            progress=CallbackProgress(None, cancelled),
+        )
+    calls.clear()
+    with pytest.raises(CancelledError):
+        dtm_from_dsm(
+            tmp_path / "raw.tif",
+            tmp_path / "dtm.tif",
+            ndsm_path=tmp_path / "ndsm.tif",
+            progress=CallbackProgress(None, cancelled),
+        )
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["raw.tif"]

@@ -61,9 +61,11 @@ def test_flat_roof_acceptance(flat_scene):
     err = top - z
     rmse = float(np.sqrt(np.mean(err**2)))
     ratio = mesh.n_vertices / z.size
-    print(f"\nmesh of {z.size} cells: {mesh.n_vertices} vertices ({ratio:.4f} per cell), "
-          f"{mesh.n_faces} faces ({res.wall_faces} wall), vertical RMSE {rmse:.4f} m = {rmse / GSD:.3f} GSD, "
-          f"max {np.abs(err).max():.4f} m; leaves {res.leaves}")
+    print(
+        f"\nmesh of {z.size} cells: {mesh.n_vertices} vertices ({ratio:.4f} per cell), "
+        f"{mesh.n_faces} faces ({res.wall_faces} wall), vertical RMSE {rmse:.4f} m = {rmse / GSD:.3f} GSD, "
+        f"max {np.abs(err).max():.4f} m; leaves {res.leaves}"
+    )
     assert not np.isnan(top).any()
     assert rmse <= 0.5 * GSD and np.abs(err).max() <= 0.5 * GSD + 1e-9
     assert mesh.n_vertices <= z.size / 4
@@ -84,8 +86,9 @@ def test_flat_roof_acceptance(flat_scene):
     # wall area ~ outline x height of the buildings (staircase outlines are longer: factor <= 4/pi)
     wa, wb, wc = (mesh.vertices[mesh.faces[vertical, k]] for k in range(3))
     wall_area = 0.5 * np.linalg.norm(np.cross(wb - wa, wc - wa), axis=1).sum()
-    expected = sum(4 * (bd.half_size[0] + bd.half_size[1]) * (bd.eave_top - bd.base)
-                   for bd in scene.surface.buildings)
+    expected = sum(
+        4 * (bd.half_size[0] + bd.half_size[1]) * (bd.eave_top - bd.base) for bd in scene.surface.buildings
+    )
     assert 0.9 * expected < wall_area < 1.4 * (4 / np.pi) * expected
     # vertex colours come from the orthoimage
     assert mesh.colours is not None and mesh.colours.std() > 10
@@ -145,8 +148,9 @@ def test_dsm_file_colours_frames_and_bad_input(tmp_path, flat_scene):
     write_raster(tmp_path / "dsm.tif", zs, sub, nodata=-9999.0)
     write_raster(tmp_path / "ortho.tif", np.moveaxis(rgb[100:260, 150:350], -1, 0), sub)
     res = mesh_from_dsm(tmp_path / "dsm.tif", DsmMeshConfig(tile=64, max_leaf=16), tmp_path / "ortho.tif")
-    ref = mesh_from_dsm_array(zs.astype(np.float64), sub, DsmMeshConfig(tile=64, max_leaf=16),
-                              rgb=rgb[100:260, 150:350])
+    ref = mesh_from_dsm_array(
+        zs.astype(np.float64), sub, DsmMeshConfig(tile=64, max_leaf=16), rgb=rgb[100:260, 150:350]
+    )
     np.testing.assert_allclose(res.mesh.vertices, ref.mesh.vertices)
     np.testing.assert_array_equal(res.mesh.faces, ref.mesh.faces)
     assert np.abs(res.mesh.colours.astype(int) - ref.mesh.colours.astype(int)).max() <= 1
@@ -199,3 +203,12 @@ def test_mesh_from_oblique_point_cloud():
     assert (zr.max(axis=1) - zr.min(axis=1)).max() < 1.0
     with pytest.raises(InputError, match="at least 3"):
         mesh_from_point_cloud(PointCloud(np.zeros((2, 3))))
+
+
+def test_cancel_mesh(tmp_path, flat_scene):
+    from truortho.core.errors import CancelledError
+    from truortho.core.progress import CallbackProgress
+
+    _, z, grid, _ = flat_scene
+    with pytest.raises(CancelledError):
+        mesh_from_dsm_array(z, grid, DsmMeshConfig(tile=128), progress=CallbackProgress(None, lambda: True))

@@ -145,6 +145,12 @@ def test_point_cloud_ept_opens_in_qgis(truortho_provider, rasters, tmp_path):
     )
     assert res2["POINTS"] == n  # exact duplicates: one per voxel
     assert QgsPointCloudLayer(res2["EPT_JSON"], "m", "ept").pointCount() == n
+    # a mesh of the point cloud (one 2.5D Delaunay mesh per reference system)
+    res3 = run("truortho:mesh", {"INPUT": res["OUTPUT"], "OUTPUT": str(tmp_path / "pc.ply")})
+    from truortho.core.surface.meshio import read_mesh
+
+    pm = read_mesh(res3["OUTPUT"])
+    assert pm.n_vertices > 0.95 * n and pm.colours is not None and pm.crs is not None
 
 
 @pytest.mark.parametrize(
