@@ -218,6 +218,11 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
                 results[self.DTM] = dtm
             if ndsm:
                 results[self.NDSM] = ndsm
+        from ..styles import style_on_load
+
+        style_on_load(context, out, "dsm", tr("Filtered DSM"))
+        if dtm:
+            style_on_load(context, dtm, "dsm", tr("DTM"))
         results[self.STATISTICS] = json.dumps(data)
         results[self.OUTLIERS_REMOVED] = stats.outliers_removed + stats.low_confidence_removed
         results[self.CELLS_FILLED] = stats.cells_filled
