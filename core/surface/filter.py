@@ -59,6 +59,9 @@ from ..grid import RasterGrid
 from ..jit import pjit, prange
 from ..progress import Progress, Steps, as_progress, check
 
+#: half side of the window of the confidence pass (15 x 15 cells)
+CONFIDENCE_HALF = 7
+
 
 @dataclass
 class DsmFilterConfig:
@@ -75,6 +78,10 @@ class DsmFilterConfig:
         Neighbours within ``t`` that keep a cell although it departs from the median.
     min_confidence : float
         With a confidence raster: cells below it are removed (0 = none).
+    confident : float
+        With a confidence raster: cells below it are removed when they depart by more than
+        ``t`` from the median of the cells at least this confident in their 15 x 15 window
+        (0 = off).
     max_hole : float
         Largest width of a hole that is filled, metres (0 = no filling).
     step : float
@@ -97,6 +104,7 @@ class DsmFilterConfig:
     outlier_window: int = 5
     min_support: int = 4
     min_confidence: float = 0.05
+    confident: float = 0.4
     max_hole: float = 10.0
     step: float = 1.0
     sharpen: bool = True
@@ -128,6 +136,8 @@ class DsmFilterConfig:
             raise InputError(
                 f"min_support: expected an integer from 0 to {w * w - 1}, got {self.min_support!r}"
             )
+        if not 0.0 <= self.confident <= 1.0:
+            raise InputError(f"confident: expected a value in [0, 1], got {self.confident!r}")
         if not 0.0 <= self.min_confidence <= 1.0:
             raise InputError(f"min_confidence: expected a value in [0, 1], got {self.min_confidence!r}")
         positive("max_hole", allow_zero=True)
@@ -147,7 +157,8 @@ class DsmFilterConfig:
         return float(self.smooth_tolerance) if self.smooth_tolerance is not None else 2.5 * res
 
     def outlier_margin(self) -> int:
-        return 2 + 3 * (self.outlier_window // 2) + 1  # sharpening (2), both outlier passes
+        # confidence pass, sharpening (2), both outlier passes
+        return CONFIDENCE_HALF + 2 + 3 * (self.outlier_window // 2) + 1
 
     def sharpen_step(self, res: float) -> float:
         return max(self.step, 2.0 * res * math.tan(math.radians(70.0)))
@@ -255,6 +266,33 @@ def _outlier_pass(z, conf, has_conf, t, half, min_support, out_mask):
                     med = vals[order[k]]
                     break
             if abs(zc - med) > tc:
+                out_mask[r, c] = True
+
+
+@pjit
+def _confidence_pass(z, conf, c_ref, t, half, out_mask):
+    """Flag cells less confident than ``c_ref`` that depart by more than ``t`` from the median of
+    the confident cells (``conf >= c_ref``) of their window (at least 8 of them)."""
+    nr, nc = z.shape
+    n_max = (2 * half + 1) ** 2
+    for r in prange(nr):
+        vals = np.empty(n_max)
+        for c in range(nc):
+            zc = z[r, c]
+            if not np.isfinite(zc) or conf[r, c] >= c_ref:
+                continue
+            n = 0
+            for rr in range(max(r - half, 0), min(r + half + 1, nr)):
+                for cc in range(max(c - half, 0), min(c + half + 1, nc)):
+                    v = z[rr, cc]
+                    if np.isfinite(v) and conf[rr, cc] >= c_ref:
+                        vals[n] = v
+                        n += 1
+            if n < 8:
+                continue
+            srt = np.sort(vals[:n])
+            med = srt[n // 2] if n % 2 else 0.5 * (srt[n // 2 - 1] + srt[n // 2])
+            if abs(zc - med) > t:
                 out_mask[r, c] = True
 
 
@@ -387,6 +425,11 @@ def _clean(z: np.ndarray, conf: np.ndarray | None, cfg: DsmFilterConfig, res: fl
     if has_conf and cfg.min_confidence > 0:
         low = np.isfinite(work) & ~(c >= cfg.min_confidence)
         work[low] = np.nan
+    if has_conf and cfg.confident > 0:
+        doubt = np.zeros(z.shape, bool)
+        _confidence_pass(work, c, cfg.confident, t, CONFIDENCE_HALF, doubt)
+        work[doubt] = np.nan
+        low |= doubt
     sharp = np.zeros(z.shape, bool)
     if cfg.sharpen:
         work, sharp = _sharpen(work, cfg, res)
