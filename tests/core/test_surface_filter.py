@@ -219,3 +219,25 @@ def test_cancel_leaves_no_output(tmp_path, scene_dsm):
             progress=CallbackProgress(None, cancelled),
         )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["raw.tif"]
+
+
+def test_confidence_kernel_matches_reference():
+    rng = np.random.default_rng(8)
+    z = rng.normal(20, 0.05, (30, 27))
+    conf = rng.uniform(0, 1, z.shape)
+    blob = (slice(10, 16), slice(8, 15))  # a 6 x 7 wrong blob of low confidence: the support test keeps it
+    z[blob] += 3.0
+    conf[blob] = rng.uniform(0, 0.3, (6, 7))
+    z[rng.random(z.shape) < 0.05] = np.nan
+    got = np.zeros(z.shape, bool)
+    F._confidence_pass(z, conf, 0.4, 1.0, 7, got)
+    ref = np.zeros(z.shape, bool)
+    for r in range(z.shape[0]):
+        for c in range(z.shape[1]):
+            if not np.isfinite(z[r, c]) or conf[r, c] >= 0.4:
+                continue
+            win = (slice(max(r - 7, 0), r + 8), slice(max(c - 7, 0), c + 8))
+            v = z[win][np.isfinite(z[win]) & (conf[win] >= 0.4)]
+            ref[r, c] = len(v) >= 8 and abs(z[r, c] - np.median(v)) > 1.0
+    np.testing.assert_array_equal(got, ref)
+    assert got[blob][np.isfinite(z[blob])].all()
