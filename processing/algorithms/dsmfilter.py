@@ -37,6 +37,7 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
     OUTLIER_WINDOW = "OUTLIER_WINDOW"
     MIN_SUPPORT = "MIN_SUPPORT"
     MIN_CONFIDENCE = "MIN_CONFIDENCE"
+    CONFIDENT = "CONFIDENT"
     MAX_HOLE = "MAX_HOLE"
     STEP = "STEP"
     SHARPEN = "SHARPEN"
@@ -94,6 +95,17 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
         )
         self.add(
             num(self.MIN_CONFIDENCE, tr("Minimum confidence"), num.Double, 0.05, minValue=0.0, maxValue=1.0),
+            advanced=True,
+        )
+        self.add(
+            num(
+                self.CONFIDENT,
+                tr("Confident cells (confidence at least)"),
+                num.Double,
+                0.4,
+                minValue=0.0,
+                maxValue=1.0,
+            ),
             advanced=True,
         )
         self.add(
@@ -168,6 +180,7 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
             outlier_window=self.parameterAsInt(parameters, self.OUTLIER_WINDOW, context),
             min_support=self.parameterAsInt(parameters, self.MIN_SUPPORT, context),
             min_confidence=self.parameterAsDouble(parameters, self.MIN_CONFIDENCE, context),
+            confident=self.parameterAsDouble(parameters, self.CONFIDENT, context),
             max_hole=self.parameterAsDouble(parameters, self.MAX_HOLE, context),
             step=self.parameterAsDouble(parameters, self.STEP, context),
             sharpen=self.parameterAsBool(parameters, self.SHARPEN, context),

@@ -132,6 +132,9 @@ HELP: dict[str, dict] = {
             "MIN_SUPPORT": "Neighbours within the threshold of a cell's height that keep it although it "
             "departs from the median (edges, corners, thin structures).",
             "MIN_CONFIDENCE": "With a confidence raster: cells below this confidence are removed.",
+            "CONFIDENT": "With a confidence raster: less confident cells are removed when they depart by "
+            "more than the threshold from the median of the cells at least this confident in their 15 x 15 "
+            "window (0: off).",
             "MAX_HOLE": "Largest hole width (metres) that is interpolated; 0 fills nothing.",
             "STEP": "Height difference between two surfaces (a wall), metres: hole boundary cells that much "
             "above nearby boundary cells are not interpolated from.",
