@@ -458,13 +458,15 @@ def _hole_width(nodata: np.ndarray) -> np.ndarray:
 _FOUR = np.array([[0, 1, 0], [1, 1, 1], [0, 1, 0]], bool)
 
 
-def _fill_holes(z: np.ndarray, fill: np.ndarray, step: float, reach: int,
-                hint: np.ndarray | None = None) -> np.ndarray:
+def _fill_holes(
+    z: np.ndarray, fill: np.ndarray, step: float, reach, hint: np.ndarray | None = None
+) -> np.ndarray:
     """Harmonic interpolation of the cells ``fill`` (nodata) from their valid 4-neighbours.
 
     Each connected component is solved with Dirichlet values on its valid boundary
     cells, except boundary cells more than ``step`` above the lowest boundary cell of
-    the same hole within ``reach`` cells (the top of a wall beside an occlusion hole;
+    the same hole within ``reach`` cells (an int, or a per-cell int array whose maximum over
+    a hole is that hole's reach) (the top of a wall beside an occlusion hole;
     a local rule, so that tiles agree): those are zero-flux, as the window border is. A component
     left without any Dirichlet cell keeps all its boundary cells.
 
@@ -495,7 +497,8 @@ def _fill_holes(z: np.ndarray, fill: np.ndarray, step: float, reach: int,
         if hz.size == 0 or hz.max() - hz.min() <= step:
             continue
         # the lowest boundary cell of this hole within `reach` of each boundary cell
-        low = ndimage.minimum_filter(np.where(ring, zs, np.inf), size=2 * reach + 1, mode="nearest")
+        rk = int(reach[r0:r1, c0:c1][sub].max()) if isinstance(reach, np.ndarray) else int(reach)
+        low = ndimage.minimum_filter(np.where(ring, zs, np.inf), size=2 * max(rk, 1) + 1, mode="nearest")
         drop = ring & (zs > low + step)
         allowed[r0:r1, c0:c1] &= ~drop
         upper[r0:r1, c0:c1] |= drop
@@ -652,7 +655,7 @@ def _run(
     om = cfg.outlier_margin()
     hole_cells = cfg.hole_cells(res)
     margin1 = om + hole_cells // 2 + 2
-    margin2 = om + (5 * hole_cells) // 2 + cfg.smooth_radius + 4
+    n_labels: list[int] = []
     stats = FilterStats(cells=grid.rows * grid.cols)
     comps = _Components()
     tiles = grid.tiles(cfg.tile, 0)
@@ -683,6 +686,7 @@ def _run(
         else:
             base = len(comps.parent)
         bases.append(base - 1)  # local label l -> base - 1 + l
+        n_labels.append(k)
         borders.append((labels[0].copy(), labels[-1].copy(), labels[:, 0].copy(), labels[:, -1].copy()))
         steps[0].update((n + 1) / len(tiles), f"DSM filter: outliers and holes, tile {n + 1}/{len(tiles)}")
     # merge labels across tile borders
@@ -707,9 +711,15 @@ def _run(
         else:
             stats.holes_filled += 1
             stats.cells_filled += comps.size[rt]
-    # pass 2: recompute, fill the small holes, smooth, write the cores
+    # pass 2: recompute, fill the small holes, smooth, write the cores. The margin of a tile covers
+    # the widest small hole touching its core: 1.5 widths for the interpolation, one width for the
+    # reach of the wall-top rule (so the result does not depend on the tiles)
     for n, t in enumerate(tiles):
         check(steps.parent)
+        roots_t = [comps.find(bases[n] + lab) for lab in range(1, n_labels[n] + 1)]
+        small_w = [comps.width[rt] for rt in roots_t if not comps.deep[rt]]
+        w_cells = int(math.ceil(max(small_w) / res)) + 2 if (small_w and cfg.max_hole > 0) else 0
+        margin2 = om + (5 * w_cells) // 2 + cfg.smooth_radius + 4
         outer = _grow(t.core, margin2, grid)
         z, conf = _read_padded(read, grid, outer)
         clean, _, _, _ = _clean(z, conf, cfg, res)
@@ -717,16 +727,21 @@ def _run(
         nodata = ~np.isfinite(clean)
         core_labels, k = ndimage.label(nodata[sl], structure=_FOUR)
         fill = np.zeros(nodata.shape, bool)
+        reach = np.zeros(nodata.shape, np.int32)
         if k and cfg.max_hole > 0:
-            small = np.array(
-                [False] + [not comps.deep[comps.find(bases[n] + lab)] for lab in range(1, k + 1)]
-            )
+            small = np.array([False] + [not comps.deep[rt] for rt in roots_t])
+            width_c = np.array([0] + [int(math.ceil(comps.width[rt] / res)) + 2 for rt in roots_t])
             core_fill = small[core_labels]
             # every window hole connected to a small core hole is the same (small) hole
             wl, _ = ndimage.label(nodata, structure=_FOUR)
             seed_labels = np.unique(wl[sl][core_fill])
-            fill = np.isin(wl, seed_labels[seed_labels > 0])
-        filled = _fill_holes(clean, fill, cfg.step, max(hole_cells, 1), z) if fill.any() else clean
+            seed_labels = seed_labels[seed_labels > 0]
+            fill = np.isin(wl, seed_labels)
+            # reach of each window hole: the width of its (global) component
+            lab_reach = np.zeros(int(wl.max()) + 1, np.int32)
+            np.maximum.at(lab_reach, wl[sl][core_fill], width_c[core_labels][core_fill])
+            reach = lab_reach[wl]
+        filled = _fill_holes(clean, fill, cfg.step, reach, z) if fill.any() else clean
         if cfg.smooth:
             smoothed, changed = _smooth(filled, cfg, res)
             stats.smoothed += int(changed[sl].sum())

@@ -213,7 +213,10 @@ def _corner_groups(z, jh, jv, gc, gr, rgb, has_rgb):
     nr, nc = z.shape
     grp = np.full((nr + 1, nc + 1, 4), -1, np.int8)
     hgt = np.full((nr + 1, nc + 1, 4), np.nan)
-    col = np.zeros((nr + 1, nc + 1, 4, 3))
+    if has_rgb:
+        col = np.zeros((nr + 1, nc + 1, 4, 3), np.float32)
+    else:
+        col = np.zeros((1, 1, 4, 3), np.float32)
     parent = np.zeros(4, np.int64)
     cr = np.zeros(4, np.int64)
     cc = np.zeros(4, np.int64)
@@ -275,8 +278,9 @@ def _corner_groups(z, jh, jv, gc, gr, rgb, has_rgb):
             for q in range(4):
                 if cnt[q] > 0:
                     hgt[i, j, q] = acc[q] / cnt[q]
-                    for b in range(3):
-                        col[i, j, q, b] = cacc[q, b] / cnt[q]
+                    if has_rgb:
+                        for b in range(3):
+                            col[i, j, q, b] = cacc[q, b] / cnt[q]
     return grp, hgt, col
 
 
@@ -448,6 +452,43 @@ def _balance(lev, kmax):
 
 
 @njit
+def _put(out_k, out_v, nv, key, li, lj, z, col, i, j, q, has_rgb):
+    """One vertex record: key, lattice row/col (world position), height, colour of group q at (i, j)."""
+    out_k[nv] = key
+    out_v[nv, 0] = li
+    out_v[nv, 1] = lj
+    out_v[nv, 2] = z
+    if has_rgb:
+        out_v[nv, 3] = col[i, j, q, 0]
+        out_v[nv, 4] = col[i, j, q, 1]
+        out_v[nv, 5] = col[i, j, q, 2]
+    return nv + 1
+
+
+@njit
+def _count(z, lev, jh, jv, core):
+    """Upper bounds of the faces and vertex records :func:`_emit` writes for a tile core."""
+    nr, nc = z.shape
+    nf = 0
+    nv = 0
+    for r in range(core[0], core[2]):
+        for c in range(core[1], core[3]):
+            k = lev[r, c]
+            if k >= 0 and r % (1 << k) == 0 and c % (1 << k) == 0:
+                nf += 4 if k == 0 else 8
+                nv += 5 if k == 0 else 9
+            if not np.isfinite(z[r, c]):
+                continue
+            if c + 1 < nc and np.isfinite(z[r, c + 1]) and not jh[r, c]:
+                nf += 2
+                nv += 4
+            if r + 1 < nr and np.isfinite(z[r + 1, c]) and not jv[r, c]:
+                nf += 2
+                nv += 4
+    return nf, nv
+
+
+@njit
 def _finer(lev, ra, ca, rb, cb, k):
     """Whether either of two cells (one per half of a leaf edge) lies in a leaf finer than level k."""
     nr, nc = lev.shape
@@ -458,15 +499,17 @@ def _finer(lev, ra, ca, rb, cb, k):
 
 
 @njit
-def _emit(z, grp, hgt, col, lev, jh, jv, core, tol, gorigin, gcols, grows, out_f, out_w, out_v):
+def _emit(
+    z, grp, hgt, col, has_rgb, lev, jh, jv, core, tol, gorigin, gcols, grows, out_f, out_w, out_k, out_v
+):
     """Triangles of the leaves and walls of the tile core.
 
     Vertex keys: lattice corner (gi, gj) with group q -> ``(gi * (gcols + 1) + gj) * 4 + q``;
     the centre of cell (gr, gc) -> ``(grows + 1) * (gcols + 1) * 4 + gr * gcols + gc``.
     ``out_f`` (M, 3) keys, ``out_w`` (M, 2) direction (drow, dcol) towards the lower side for
-    walls, (0, 0) for surface faces; ``out_v`` (V, 7) key, lattice row, lattice col, z, r, g, b
-    (one record per emitted vertex, duplicates allowed; lattice coordinates of a cell
-    centre are +0.5). Returns (faces, vertex records).
+    walls, (0, 0) for surface faces; ``out_k`` (V,) keys and ``out_v`` (V, 6) lattice row,
+    lattice col, z, r, g, b of the vertex records (one per emitted vertex, duplicates allowed;
+    lattice coordinates of a cell centre are +0.5). Returns (faces, vertex records).
     """
     nr, nc = z.shape
     r0c, c0c, r1c, c1c = core[0], core[1], core[2], core[3]
@@ -519,14 +562,7 @@ def _emit(z, grp, hgt, col, lev, jh, jv, core, tol, gorigin, gcols, grows, out_f
                 p = 2 * (rr[t] - i + 1) + (cc_[t] - j + 1)
                 q = grp[i, j, p]
                 keys[t] = ((gr0 + i) * (gcols + 1) + (gc0 + j)) * 4 + q
-                out_v[nv, 0] = keys[t]
-                out_v[nv, 1] = gr0 + i
-                out_v[nv, 2] = gc0 + j
-                out_v[nv, 3] = hgt[i, j, q]
-                out_v[nv, 4] = col[i, j, q, 0]
-                out_v[nv, 5] = col[i, j, q, 1]
-                out_v[nv, 6] = col[i, j, q, 2]
-                nv += 1
+                nv = _put(out_k, out_v, nv, keys[t], gr0 + i, gc0 + j, hgt[i, j, q], col, i, j, q, has_rgb)
             centre = -1
             if cnt > 4:
                 # fan from the leaf centre (a lattice point of the uniform block)
@@ -534,14 +570,7 @@ def _emit(z, grp, hgt, col, lev, jh, jv, core, tol, gorigin, gcols, grows, out_f
                 j = c + h
                 q = grp[i, j, 3]
                 centre = ((gr0 + i) * (gcols + 1) + (gc0 + j)) * 4 + q
-                out_v[nv, 0] = centre
-                out_v[nv, 1] = gr0 + i
-                out_v[nv, 2] = gc0 + j
-                out_v[nv, 3] = hgt[i, j, q]
-                out_v[nv, 4] = col[i, j, q, 0]
-                out_v[nv, 5] = col[i, j, q, 1]
-                out_v[nv, 6] = col[i, j, q, 2]
-                nv += 1
+                nv = _put(out_k, out_v, nv, centre, gr0 + i, gc0 + j, hgt[i, j, q], col, i, j, q, has_rgb)
             elif k == 0:
                 # a single cell: the better diagonal, or a centre vertex with the cell's height
                 zz = z[r, c]
@@ -553,18 +582,18 @@ def _emit(z, grp, hgt, col, lev, jh, jv, core, tol, gorigin, gcols, grows, out_f
                 e2 = abs(0.5 * (htr + hbl) - zz)
                 if min(e1, e2) > tol:
                     centre = base + (gr0 + r) * gcols + (gc0 + c)
-                    out_v[nv, 0] = centre
-                    out_v[nv, 1] = gr0 + r + 0.5
-                    out_v[nv, 2] = gc0 + c + 0.5
-                    out_v[nv, 3] = zz
-                    # colour: mean of the corner colours of the cell's own groups
-                    for b in range(3):
-                        out_v[nv, 4 + b] = 0.25 * (
-                            col[ii[0], jj[0], grp[ii[0], jj[0], 3], b]
-                            + col[ii[1], jj[1], grp[ii[1], jj[1], 2], b]
-                            + col[ii[2], jj[2], grp[ii[2], jj[2], 0], b]
-                            + col[ii[3], jj[3], grp[ii[3], jj[3], 1], b]
-                        )
+                    out_k[nv] = centre
+                    out_v[nv, 0] = gr0 + r + 0.5
+                    out_v[nv, 1] = gc0 + c + 0.5
+                    out_v[nv, 2] = zz
+                    if has_rgb:  # colour: mean of the corner colours of the cell's own groups
+                        for b in range(3):
+                            out_v[nv, 3 + b] = 0.25 * (
+                                col[ii[0], jj[0], grp[ii[0], jj[0], 3], b]
+                                + col[ii[1], jj[1], grp[ii[1], jj[1], 2], b]
+                                + col[ii[2], jj[2], grp[ii[2], jj[2], 0], b]
+                                + col[ii[3], jj[3], grp[ii[3], jj[3], 1], b]
+                            )
                     nv += 1
                 elif e2 < e1:
                     # diagonal TR-BL (ring order TL, TR, BR, BL)
@@ -616,14 +645,7 @@ def _emit(z, grp, hgt, col, lev, jh, jv, core, tol, gorigin, gcols, grows, out_f
                     j = ijp[1]
                     q = grp[i, j, ijp[2]]
                     ks[t] = ((gr0 + i) * (gcols + 1) + (gc0 + j)) * 4 + q
-                    out_v[nv, 0] = ks[t]
-                    out_v[nv, 1] = gr0 + i
-                    out_v[nv, 2] = gc0 + j
-                    out_v[nv, 3] = hgt[i, j, q]
-                    out_v[nv, 4] = col[i, j, q, 0]
-                    out_v[nv, 5] = col[i, j, q, 1]
-                    out_v[nv, 6] = col[i, j, q, 2]
-                    nv += 1
+                    nv = _put(out_k, out_v, nv, ks[t], gr0 + i, gc0 + j, hgt[i, j, q], col, i, j, q, has_rgb)
                     t += 1
                 for tri in range(2):
                     x0 = ks[0]
@@ -681,6 +703,7 @@ def _mesh_tiles(
     faces_l: list[np.ndarray] = []
     walls_l: list[np.ndarray] = []
     verts_l: list[np.ndarray] = []
+    keys_l: list[np.ndarray] = []
     leaves: dict[int, int] = {}
     n_cells = 0
     tiles = grid.tiles(tile, 0)
@@ -700,7 +723,8 @@ def _mesh_tiles(
         rgb_a = np.ascontiguousarray(rgb, dtype=np.float64) if rgb is not None else np.zeros((1, 1, 3))
         jh, jv = _joins(z, thr)
         gc, gr = _gradients(z, jh, jv)
-        grp, hgt, col = _corner_groups(z, jh, jv, gc, gr, rgb_a, has_rgb and rgb is not None)
+        use_rgb = has_rgb and rgb is not None
+        grp, hgt, col = _corner_groups(z, jh, jv, gc, gr, rgb_a, use_rgb)
         uni = _uniform0(z, jh, jv)
         lev = _leaf_levels(z, grp, hgt, uni, tol, kmax)
         _balance(lev, kmax)
@@ -710,16 +734,18 @@ def _mesh_tiles(
             cnt = int(np.count_nonzero(core_lev == k)) // (s * s)
             if cnt:
                 leaves[s] = leaves.get(s, 0) + cnt
-        cap_f = 8 * nvalid + 16
-        out_f = np.zeros((cap_f, 3), np.int64)
-        out_w = np.zeros((cap_f, 2))
-        out_v = np.zeros((3 * cap_f, 7))
         core = np.array([margin, margin, margin + nr, margin + nc], np.int64)
+        cap_f, cap_v = _count(z, lev, jh, jv, core)
+        out_f = np.zeros((cap_f, 3), np.int64)
+        out_w = np.zeros((cap_f, 2), np.int8)
+        out_k = np.zeros(cap_v, np.int64)
+        out_v = np.zeros((cap_v, 6))
         nf, nv = _emit(
             z,
             grp,
             hgt,
             col,
+            use_rgb,
             lev,
             jh,
             jv,
@@ -730,24 +756,28 @@ def _mesh_tiles(
             rows,
             out_f,
             out_w,
+            out_k,
             out_v,
         )
         faces_l.append(out_f[:nf].copy())
         walls_l.append(out_w[:nf].copy())
+        keys_l.append(out_k[:nv].copy())
         verts_l.append(out_v[:nv].copy())
+        del out_f, out_w, out_k, out_v, grp, hgt, col
         prog.update((n + 1) / len(tiles), f"mesh tile {n + 1}/{len(tiles)}")
     if n_cells == 0:
         raise InputError("the DSM has no valid cells (all nodata): nothing to mesh")
     fkeys = np.concatenate(faces_l)
     wdir = np.concatenate(walls_l)
     vrec = np.concatenate(verts_l)
-    ukeys, first = np.unique(vrec[:, 0].astype(np.int64), return_index=True)
+    vkeys = np.concatenate(keys_l)
+    ukeys, first = np.unique(vkeys, return_index=True)
     vr = vrec[first]
     faces = np.searchsorted(ukeys, fkeys).astype(np.int64)
-    x = grid.x_min + vr[:, 2] * res
-    y = grid.y_max - vr[:, 1] * res
-    vertices = np.column_stack([x, y, vr[:, 3]])
-    colours = np.clip(np.round(vr[:, 4:7]), 0, 255).astype(np.uint8) if has_rgb else None
+    x = grid.x_min + vr[:, 1] * res
+    y = grid.y_max - vr[:, 0] * res
+    vertices = np.column_stack([x, y, vr[:, 2]])
+    colours = np.clip(np.round(vr[:, 3:6]), 0, 255).astype(np.uint8) if has_rgb else None
     faces = _orient(vertices, faces, wdir)
     mesh = Mesh(vertices, faces, colours, grid.crs)
     n_walls = int(np.count_nonzero(np.any(wdir != 0, axis=1)))
