@@ -711,15 +711,15 @@ def _run(
         else:
             stats.holes_filled += 1
             stats.cells_filled += comps.size[rt]
-    # pass 2: recompute, fill the small holes, smooth, write the cores. The margin of a tile covers
-    # the widest small hole touching its core: 1.5 widths for the interpolation, one width for the
-    # reach of the wall-top rule (so the result does not depend on the tiles)
+    # pass 2: recompute, fill the small holes, smooth, write the cores. The margin of a tile with
+    # small holes touching its core covers 1.5 times the widest of them (the interpolation) plus
+    # the reach of the wall-top rule (max_hole), so the result does not depend on the tiles
     for n, t in enumerate(tiles):
         check(steps.parent)
         roots_t = [comps.find(bases[n] + lab) for lab in range(1, n_labels[n] + 1)]
         small_w = [comps.width[rt] for rt in roots_t if not comps.deep[rt]]
         w_cells = int(math.ceil(max(small_w) / res)) + 2 if (small_w and cfg.max_hole > 0) else 0
-        margin2 = om + (5 * w_cells) // 2 + cfg.smooth_radius + 4
+        margin2 = om + ((3 * w_cells) // 2 + hole_cells if w_cells else 0) + cfg.smooth_radius + 4
         outer = _grow(t.core, margin2, grid)
         z, conf = _read_padded(read, grid, outer)
         clean, _, _, _ = _clean(z, conf, cfg, res)
@@ -730,14 +730,14 @@ def _run(
         reach = np.zeros(nodata.shape, np.int32)
         if k and cfg.max_hole > 0:
             small = np.array([False] + [not comps.deep[rt] for rt in roots_t])
-            width_c = np.array([0] + [int(math.ceil(comps.width[rt] / res)) + 2 for rt in roots_t])
+            width_c = np.array([0] + [max(hole_cells, 1)] * len(roots_t))
             core_fill = small[core_labels]
             # every window hole connected to a small core hole is the same (small) hole
             wl, _ = ndimage.label(nodata, structure=_FOUR)
             seed_labels = np.unique(wl[sl][core_fill])
             seed_labels = seed_labels[seed_labels > 0]
             fill = np.isin(wl, seed_labels)
-            # reach of each window hole: the width of its (global) component
+            # reach of the wall-top rule for each window hole (max_hole; per hole for future use)
             lab_reach = np.zeros(int(wl.max()) + 1, np.int32)
             np.maximum.at(lab_reach, wl[sl][core_fill], width_c[core_labels][core_fill])
             reach = lab_reach[wl]
