@@ -24,7 +24,8 @@ LAS_FILTER = "LAZ (compressed) (*.laz);;LAS (*.las)"
 def _ept_folder(alg, parameters, name, context) -> str | None:
     if not parameters.get(name):
         return None
-    return alg.parameterAsString(parameters, name, context) or None
+    # resolves TEMPORARY_OUTPUT (the GUI's default) to a folder in the processing temp folder
+    return alg.parameterAsFileOutput(parameters, name, context) or None
 
 
 class DsmToPointCloudAlgorithm(TruOrthoAlgorithm):
