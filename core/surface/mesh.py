@@ -73,6 +73,9 @@ class DsmMeshConfig:
         Largest quadtree block side in cells (a power of two, 1 to 256).
     tile : int
         Tile core side in cells (rounded up to a multiple of ``max_leaf``).
+    chamfer : bool
+        Cut the stair corners of walls by a quarter cell (straight walls for outlines at
+        45 degrees to the grid, chamfers for other angles).
     """
 
     max_error: float | None = None
@@ -80,6 +83,7 @@ class DsmMeshConfig:
     max_slope_deg: float = 70.0
     max_leaf: int = 64
     tile: int = 1024
+    chamfer: bool = True
 
     def validate(self) -> None:
         if self.max_error is not None and not (math.isfinite(self.max_error) and self.max_error > 0):
@@ -308,11 +312,24 @@ def _uniform0(z, jh, jv):
 
 @njit
 def _bary(u, v, u0, v0, h0, u1, v1, h1, u2, v2, h2):
-    """Linear interpolation at (u, v) of the plane through three points."""
+    """Linear interpolation at (u, v) of the plane through three points (their mean if degenerate)."""
     d = (v1 - v2) * (u0 - u2) + (u2 - u1) * (v0 - v2)
+    if d == 0.0:
+        return (h0 + h1 + h2) / 3.0
     w0 = ((v1 - v2) * (u - u2) + (u2 - u1) * (v - v2)) / d
     w1 = ((v2 - v0) * (u - u2) + (u0 - u2) * (v - v2)) / d
     return w0 * h0 + w1 * h1 + (1.0 - w0 - w1) * h2
+
+
+@njit
+def _inside(u, v, u0, v0, u1, v1, u2, v2):
+    """Whether (u, v) lies in the triangle (or on its border); False for a degenerate triangle."""
+    d = (v1 - v2) * (u0 - u2) + (u2 - u1) * (v0 - v2)
+    if d == 0.0:
+        return False
+    w0 = ((v1 - v2) * (u - u2) + (u2 - u1) * (v - v2)) / d
+    w1 = ((v2 - v0) * (u - u2) + (u0 - u2) * (v - v2)) / d
+    return w0 >= -1e-12 and w1 >= -1e-12 and 1.0 - w0 - w1 >= -1e-12
 
 
 @njit
@@ -452,6 +469,89 @@ def _balance(lev, kmax):
 
 
 @njit
+def _corner_shifts(z, grp, lev):
+    """Chamfer of the stair corners of walls: per lattice corner, the (row, col) shift in cells.
+
+    A corner whose four cells are single-cell leaves, valid, and split into exactly two groups,
+    one of them a single cell (the corner of a staircase outline, convex or concave), moves a
+    quarter cell along both axes towards that cell's centre; every vertex there (the top and
+    the bottom of the walls) moves alike, so walls stay vertical and a 45-degree staircase becomes
+    a straight wall.
+    """
+    nr, nc = z.shape
+    sr = np.zeros((nr + 1, nc + 1))
+    sc = np.zeros((nr + 1, nc + 1))
+    for i in range(1, nr):
+        for j in range(1, nc):
+            good = True
+            for p in range(4):
+                r = i - 1 + p // 2
+                c = j - 1 + p % 2
+                if lev[r, c] != 0 or not np.isfinite(z[r, c]):
+                    good = False
+            if not good:
+                continue
+            # groups: representatives; count members of each
+            n0 = 0
+            odd = -1
+            for q in range(4):
+                members = 0
+                for p in range(4):
+                    if grp[i, j, p] == q:
+                        members += 1
+                if members > 0:
+                    n0 += 1
+                    if members == 1:
+                        for p in range(4):
+                            if grp[i, j, p] == q:
+                                odd = p
+            if n0 != 2 or odd < 0:
+                continue
+            sr[i, j] = 0.25 if odd >= 2 else -0.25
+            sc[i, j] = 0.25 if odd % 2 == 1 else -0.25
+    # a cell whose shifted corners no longer form a convex quad (neighbouring chamfers pulling
+    # two ways) keeps its corners in place
+    changed = True
+    while changed:
+        changed = False
+        for r in range(nr):
+            for c in range(nc):
+                if lev[r, c] != 0:
+                    continue
+                if not _convex_cell(sr, sc, r, c):
+                    for i, j in ((r, c), (r, c + 1), (r + 1, c + 1), (r + 1, c)):
+                        if sr[i, j] != 0.0 or sc[i, j] != 0.0:
+                            sr[i, j] = 0.0
+                            sc[i, j] = 0.0
+                            changed = True
+    return sr, sc
+
+
+@njit
+def _convex_cell(sr, sc, r, c):
+    """Whether the (shifted) corners of cell (r, c) form a strictly convex quad (margin 0.05 cell^2)."""
+    us = np.empty(4)
+    vs = np.empty(4)
+    k = 0
+    for i, j, du, dv in (
+        (r, c, 0.0, 0.0),
+        (r, c + 1, 1.0, 0.0),
+        (r + 1, c + 1, 1.0, 1.0),
+        (r + 1, c, 0.0, 1.0),
+    ):
+        us[k] = du + sc[i, j]
+        vs[k] = dv + sr[i, j]
+        k += 1
+    for k in range(4):
+        a = (k + 1) % 4
+        b = (k + 2) % 4
+        cross = (us[a] - us[k]) * (vs[b] - vs[a]) - (vs[a] - vs[k]) * (us[b] - us[a])
+        if cross < 0.05:
+            return False
+    return True
+
+
+@njit
 def _put(out_k, out_v, nv, key, li, lj, z, col, i, j, q, has_rgb):
     """One vertex record: key, lattice row/col (world position), height, colour of group q at (i, j)."""
     out_k[nv] = key
@@ -500,7 +600,25 @@ def _finer(lev, ra, ca, rb, cb, k):
 
 @njit
 def _emit(
-    z, grp, hgt, col, has_rgb, lev, jh, jv, core, tol, gorigin, gcols, grows, out_f, out_w, out_k, out_v
+    z,
+    grp,
+    hgt,
+    col,
+    has_rgb,
+    lev,
+    jh,
+    jv,
+    sr,
+    sc,
+    core,
+    tol,
+    gorigin,
+    gcols,
+    grows,
+    out_f,
+    out_w,
+    out_k,
+    out_v,
 ):
     """Triangles of the leaves and walls of the tile core.
 
@@ -562,7 +680,20 @@ def _emit(
                 p = 2 * (rr[t] - i + 1) + (cc_[t] - j + 1)
                 q = grp[i, j, p]
                 keys[t] = ((gr0 + i) * (gcols + 1) + (gc0 + j)) * 4 + q
-                nv = _put(out_k, out_v, nv, keys[t], gr0 + i, gc0 + j, hgt[i, j, q], col, i, j, q, has_rgb)
+                nv = _put(
+                    out_k,
+                    out_v,
+                    nv,
+                    keys[t],
+                    gr0 + i + sr[i, j],
+                    gc0 + j + sc[i, j],
+                    hgt[i, j, q],
+                    col,
+                    i,
+                    j,
+                    q,
+                    has_rgb,
+                )
             centre = -1
             if cnt > 4:
                 # fan from the leaf centre (a lattice point of the uniform block)
@@ -578,8 +709,22 @@ def _emit(
                 htr = hgt[ii[1], jj[1], grp[ii[1], jj[1], 2]]
                 hbr = hgt[ii[2], jj[2], grp[ii[2], jj[2], 0]]
                 hbl = hgt[ii[3], jj[3], grp[ii[3], jj[3], 1]]
-                e1 = abs(0.5 * (htl + hbr) - zz)
-                e2 = abs(0.5 * (htr + hbl) - zz)
+                # corners in cell coordinates (u = column, v = row), with their chamfer shifts
+                u0, v0 = sc[ii[0], jj[0]], sr[ii[0], jj[0]]
+                u1, v1 = 1.0 + sc[ii[1], jj[1]], sr[ii[1], jj[1]]
+                u2, v2 = 1.0 + sc[ii[2], jj[2]], 1.0 + sr[ii[2], jj[2]]
+                u3, v3 = sc[ii[3], jj[3]], 1.0 + sr[ii[3], jj[3]]
+                # height at the centre under diagonal TL-BR and under TR-BL
+                if _inside(0.5, 0.5, u0, v0, u1, v1, u2, v2):
+                    a1 = _bary(0.5, 0.5, u0, v0, htl, u1, v1, htr, u2, v2, hbr)
+                else:
+                    a1 = _bary(0.5, 0.5, u0, v0, htl, u2, v2, hbr, u3, v3, hbl)
+                if _inside(0.5, 0.5, u0, v0, u1, v1, u3, v3):
+                    a2 = _bary(0.5, 0.5, u0, v0, htl, u1, v1, htr, u3, v3, hbl)
+                else:
+                    a2 = _bary(0.5, 0.5, u1, v1, htr, u2, v2, hbr, u3, v3, hbl)
+                e1 = abs(a1 - zz)
+                e2 = abs(a2 - zz)
                 if min(e1, e2) > tol:
                     centre = base + (gr0 + r) * gcols + (gc0 + c)
                     out_k[nv] = centre
@@ -645,7 +790,20 @@ def _emit(
                     j = ijp[1]
                     q = grp[i, j, ijp[2]]
                     ks[t] = ((gr0 + i) * (gcols + 1) + (gc0 + j)) * 4 + q
-                    nv = _put(out_k, out_v, nv, ks[t], gr0 + i, gc0 + j, hgt[i, j, q], col, i, j, q, has_rgb)
+                    nv = _put(
+                        out_k,
+                        out_v,
+                        nv,
+                        ks[t],
+                        gr0 + i + sr[i, j],
+                        gc0 + j + sc[i, j],
+                        hgt[i, j, q],
+                        col,
+                        i,
+                        j,
+                        q,
+                        has_rgb,
+                    )
                     t += 1
                 for tri in range(2):
                     x0 = ks[0]
@@ -740,6 +898,10 @@ def _mesh_tiles(
         out_w = np.zeros((cap_f, 2), np.int8)
         out_k = np.zeros(cap_v, np.int64)
         out_v = np.zeros((cap_v, 6))
+        if config.chamfer:
+            sr, sc = _corner_shifts(z, grp, lev)
+        else:
+            sr = sc = np.zeros((z.shape[0] + 1, z.shape[1] + 1))
         nf, nv = _emit(
             z,
             grp,
@@ -749,6 +911,8 @@ def _mesh_tiles(
             lev,
             jh,
             jv,
+            sr,
+            sc,
             core,
             tol,
             np.array([wr0, wc0], np.int64),
