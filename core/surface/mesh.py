@@ -27,6 +27,12 @@ otherwise, when both are valid, the edge between them is a *step*.
   test stay single cells (two triangles, or four from a centre vertex with
   the cell's own height when two do not fit within ``max_error``).
 
+* **Stair corners** of walls (a corner whose four cells are single-cell leaves
+  split 1 : 3 into two groups) move a quarter cell along both axes towards the
+  odd cell, all their vertices alike (walls stay vertical, outlines at 45 degrees
+  become straight), unless a cell's quad would lose convexity; single cells choose
+  their diagonal (or centre vertex) with the moved corners.
+
 Hence the **vertical error bound**: at every valid cell centre the mesh's
 surface differs from the DSM value by at most ``max_error``.
 
