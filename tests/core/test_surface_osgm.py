@@ -1,7 +1,7 @@
 """Acceptance of the DSM filter on a real OSGM DSM of a synthetic block (runs once core/osgm is merged).
 
 The raw DSM and its confidence come from ``truortho.core.osgm.run_osgm`` (API of the osgm branch
-at f76deda: ``run_osgm(orientation, OsgmConfig(), extent, OsgmOutputs(dsm=, confidence=),
+at f76deda: ``run_osgm(orientation, OsgmConfig(resolution=), extent, OsgmOutputs(dsm=, confidence=),
 image_root=)``); the truth is the scene's analytic surface at the DSM's cell centres.
 """
 
@@ -33,7 +33,7 @@ def test_filtered_osgm_dsm_is_closer_to_the_truth(tmp_path):
     scene.write(tmp_path)
     osgm.run_osgm(
         scene.orientation,
-        osgm.OsgmConfig(),
+        osgm.OsgmConfig(resolution=0.4),
         None,
         osgm.OsgmOutputs(dsm=tmp_path / "raw.tif", confidence=tmp_path / "conf.tif"),
         image_root=tmp_path,
