@@ -9,6 +9,7 @@ from ..i18n import tr
 
 GROUPS = {
     "orientation": "Orientation",
+    "surface": "Surface",
     "tools": "Tools",
 }
 
