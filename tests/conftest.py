@@ -115,9 +115,12 @@ def truortho_plugin(qgis_processing_ready):
     plugin.unload()
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture
 def truortho_provider(truortho_plugin):
+    """The registered provider, looked up per test (a GUI test may unload and re-register it)."""
     from qgis.core import QgsApplication
+
+    truortho_plugin.initProcessing()
 
     provider = QgsApplication.processingRegistry().providerById("truortho")
     assert provider is not None, "TruOrtho provider is not registered"
