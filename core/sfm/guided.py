@@ -435,16 +435,17 @@ def search_scale(
     win = cfg.window_px / focal_px
     valid_u = np.all(np.isfinite(u), axis=1)
     u_k = np.where(valid_u[:, None], u, 1e9)  # undistortion failures never match
-    has_desc = np.diff(poff) > 0
-    A_use = np.where(has_desc[:, None], A, np.array([0.0, 0.0, -1.0]))  # no descriptor: never a candidate
-    per_point = _count_line_candidates(A_use, T, u_k, s_lo, s_hi, win)
+    # points without a descriptor can never match: no candidates for them
+    per_point = np.zeros(len(A), np.int64)
+    has_desc = np.flatnonzero(np.diff(poff) > 0)
+    per_point[has_desc] = _count_line_candidates(A[has_desc], T, u_k, s_lo, s_hi, win)
     offsets = np.concatenate([[0], np.cumsum(per_point)]).astype(np.int64)
     n_cand = int(offsets[-1])
     if n_cand == 0:
         return ScaleSearch(False, "no block point projects near a feature of the image in the search range")
     feat = np.zeros(n_cand, np.int64)
     scale = np.zeros(n_cand)
-    _fill_line_candidates(A_use, T, u_k, s_lo, s_hi, win, offsets, feat, scale)
+    _fill_line_candidates(A, T, u_k, s_lo, s_hi, win, offsets, feat, scale)
     cand_pt = np.repeat(np.arange(len(A), dtype=np.int64), per_point)
     dist = np.zeros(n_cand, np.float32)
     _min_descriptor_distance(cand_pt, feat, poff, pdesc, fdesc, dist)
@@ -492,7 +493,7 @@ def search_scale(
         scale=s,
         count=len(pts),
         expected_false=float(l1[0]),
-        log10_nfa=min(lnfa_s, float(lnfa[best])),
+        log10_nfa=lnfa_s,
         n_hypotheses=len(hyps),
         n_candidates=n_cand,
         points=pts,

@@ -27,22 +27,22 @@ CAM = Camera(1200, 800, 1000.0, 1000.0, 601.3, 398.2, -0.05, 0.01, 0.0, 2e-4, -1
 def weak_group_block(
     seed=0, group_sees_strip=True, descriptor_noise=0.08, noise_px=0.3, clutter=0.3, complete=False
 ):
-    """Tracks, features and truth of a strip (8 images) with a weakly linked group of 3 before it.
+    """Tracks, features and truth of a strip (6 images) with a weakly linked group of 3 before it.
 
-    Strip images at x = 0, 25, ..., 175 m, group at x = -150, -125, -100 m, height 120 m (footprint
+    Strip images at x = 0, 25, ..., 125 m, group at x = -150, -125, -100 m, height 120 m (footprint
     144 x 96 m). The group's last image overlaps the first strip image by 44 m and the second by
     19 m. ``group_sees_strip=False`` removes from the group's features every point also seen by a
     strip image other than the first (a purely two-view link: its scale cannot be measured);
     ``complete=True`` puts the missed observations into the tracks (perfect matching: the reference).
     """
     rng = np.random.default_rng(seed)
-    xs = [-150.0, -125.0, -100.0] + [25.0 * k for k in range(8)]
+    xs = [-150.0, -125.0, -100.0] + [25.0 * k for k in range(6)]
     group = {0, 1, 2}
     Rs = np.array([opk_to_matrix(*rng.normal(0, 1.5, 2), rng.normal(0, 2), degrees=True) for _ in xs])
     Cs = np.array([[x + rng.normal(0, 1), rng.normal(0, 1), 120 + rng.normal(0, 1)] for x in xs])
-    n_pts = 9000
+    n_pts = 6000
     X = np.column_stack(
-        [rng.uniform(-230, 260, n_pts), rng.uniform(-50, 50, n_pts), rng.uniform(0, 12, n_pts)]
+        [rng.uniform(-230, 210, n_pts), rng.uniform(-50, 50, n_pts), rng.uniform(0, 12, n_pts)]
     )
     desc_X = rng.normal(size=(n_pts, 64)).astype(np.float32)
     desc_X /= np.linalg.norm(desc_X, axis=1, keepdims=True)
@@ -142,7 +142,8 @@ def test_weak_group_registered_by_guided_matching(block):
 
     e, e_ref = strip_aligned_errors(rec), strip_aligned_errors(rec_ref)
     print("centre errors [m], guided", np.round(e, 3), "complete matching", np.round(e_ref, 3))
-    assert np.all(e[:3] <= 1.2 * e_ref[:3] + 0.05)
+    # (a wrong baseline length would put the group metres off: 1 % of the 100 m to the strip is 1 m)
+    assert np.all(e[:3] <= 2.0 * e_ref[:3] + 0.15)
     assert e[3:].max() < 0.1
     # the added observations are those of their tracks' true points (feature index = point row)
     n_in = len(block["track"])
