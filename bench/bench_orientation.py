@@ -27,6 +27,8 @@ fresh temporary work folders (no feature caches carried over), so its wall time 
 memory (``resource.getrusage``, self + children) are its own. TruOrtho's numba code is compiled
 once and cached in ``~/.cache/truortho/numba``, as for users.
 
+The table also gives TruOrtho's sigma0 of the final adjustment and how many images were
+registered by guided matching (weakly connected images, ``core/sfm/guided.py``).
 A Markdown table per dataset is printed; the results are also written (merged by dataset) to
 ``bench/results/orientation.json``.
 """
@@ -138,6 +140,13 @@ def run_ours(ds: dict, working_size: int, work_dir: str) -> dict:
     )
     if ds["gcp_file"]:
         out["check_rmse"] = {k: _float(v) for k, v in (data.get("check_rmse") or {}).items()}
+    guided = (data.get("stats") or {}).get("reconstruction", {}).get("guided", [])
+    out["guided"] = [
+        {k: e.get(k) for k in ("image", "partner", "pair_points", "guided_inliers", "rms_px")}
+        | {"log10_nfa": (e.get("scale_search") or {}).get("log10_nfa")}
+        for e in guided
+        if e.get("registered")
+    ]
     out["peak_rss_mb"] = _peak_rss_mb()
     return out
 
@@ -342,6 +351,8 @@ def print_table(dataset: str, results: dict) -> None:
         "peak memory [MB]",
         "centre RMSE [m]",
         "rotation error mean/max [deg]",
+        "sigma0 [px]",
+        "guided",
     ]
     if dataset == "copr":
         head.append("check RMSE X/Y [m]")
@@ -368,6 +379,8 @@ def print_table(dataset: str, results: dict) -> None:
                 _fmt(r.get("peak_rss_mb"), ".0f"),
                 _fmt(acc.get("centre_rmse_m"), ".4f"),
                 rot,
+                _fmt(r.get("sigma0"), ".3f"),
+                str(len(r["guided"])) if "guided" in r else "–",
             ]
             if dataset == "copr":
                 c = r.get("check_rmse") or {}

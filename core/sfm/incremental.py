@@ -22,6 +22,15 @@ Method (as COLMAP/OpenSfM, with the adjustment written here):
    length is refined once three images are registered, the configured
    intrinsics subset in the final adjustment; observations with residuals
    above ``max_reproj_px`` are then rejected and points re-triangulated.
+5. **Guided registration** (:mod:`.guided`, when the features are given):
+   when no image can be resected any more, an unregistered image with a
+   verified two-view link to a registered partner gets its rotation and
+   baseline direction from the relative orientation to that partner and its
+   baseline length from guided matches of block points along their epipolar
+   segments, accepted only when significant (a-contrario test) and
+   confirmed by a local adjustment (only the new image free: reprojection
+   error of the guided matches, number of points, intersection angle). The
+   matches become observations of their tracks.
 """
 
 from __future__ import annotations
@@ -36,6 +45,7 @@ from ..errors import InputError
 from ..geometry.camera import Camera, undistort_points
 from ..progress import Progress, as_progress, check
 from .bundle import BundleConfig, BundleProblem, bundle_adjust
+from .guided import GuidedConfig, relative_pose, search_scale
 from .triangulation import triangulate_tracks
 
 
@@ -73,6 +83,8 @@ class IncrementalConfig:
     loss_scale_px: float = 2.0
     #: Seed of the random sample consensus steps.
     seed: int = 0
+    #: Guided registration of weakly connected images (needs the features, see :func:`reconstruct`).
+    guided: GuidedConfig = field(default_factory=GuidedConfig)
 
     def validate(self) -> None:
         from .bundle.problem import INTRINSIC_NAMES
@@ -85,6 +97,7 @@ class IncrementalConfig:
         for name in ("ransac_threshold_px", "pnp_threshold_px", "max_reproj_px", "loss_scale_px"):
             if not getattr(self, name) > 0:
                 raise InputError(f"{name} must be positive")
+        self.guided.validate()
 
 
 @dataclass
@@ -103,9 +116,14 @@ class Reconstruction:
     points : (n_tracks, 3)
         One point per track; NaN where the track is not triangulated.
     obs_valid : (n_obs,) bool
-        Observations used by the final model (inliers).
+        Observations used by the final model (inliers), over ``obs_*``.
     stats : dict
-        Initial pair, registration order, adjustments (sigma0, RMS), timings.
+        Initial pair, registration order, adjustments (sigma0, RMS), guided
+        registrations, timings.
+    obs_track, obs_image, obs_feature : (n_obs,) int64; obs_xy : (n_obs, 2) float64
+        The observations of the model: the input ones (same order, first)
+        followed by those added by guided matching (``obs_feature`` -1 where
+        the input gave none).
     """
 
     registered: np.ndarray
@@ -115,6 +133,10 @@ class Reconstruction:
     points: np.ndarray
     obs_valid: np.ndarray
     stats: dict = field(default_factory=dict)
+    obs_track: np.ndarray | None = None
+    obs_image: np.ndarray | None = None
+    obs_xy: np.ndarray | None = None
+    obs_feature: np.ndarray | None = None
 
     @property
     def point_ok(self) -> np.ndarray:
@@ -124,10 +146,17 @@ class Reconstruction:
 class _State:
     """Arrays of the reconstruction while it grows."""
 
-    def __init__(self, obs_track, obs_image, obs_xy, image_camera, cameras: list[Camera]) -> None:
+    def __init__(
+        self, obs_track, obs_image, obs_xy, image_camera, cameras: list[Camera], obs_feature=None
+    ) -> None:
         self.track = obs_track
         self.image = obs_image
         self.xy = obs_xy
+        self.feature = (
+            np.full(len(obs_track), -1, np.int64)
+            if obs_feature is None
+            else np.asarray(obs_feature, np.int64)
+        )
         self.image_camera = image_camera
         self.cameras = cameras
         self.intr = np.array([c.params for c in cameras])
@@ -138,12 +167,34 @@ class _State:
         self.reg = np.zeros(self.n_img, dtype=bool)
         self.X = np.full((self.n_tracks, 3), np.nan)
         self.valid = np.ones(len(obs_track), dtype=bool)
-        # track -> observations (CSR)
-        order = np.argsort(obs_track, kind="stable")
-        self.t_order = order
-        self.t_offsets = np.searchsorted(obs_track[order], np.arange(self.n_tracks + 1))
+        self.xn: np.ndarray = np.empty_like(self.xy)
+        self._index_tracks()
         self.focal = self.intr[image_camera, 0]
         self.normalize()
+
+    def _index_tracks(self) -> None:
+        # track -> observations (CSR)
+        order = np.argsort(self.track, kind="stable")
+        self.t_order = order
+        self.t_offsets = np.searchsorted(self.track[order], np.arange(self.n_tracks + 1))
+
+    def add_observations(self, track, image, xy, feature) -> None:
+        """Append (valid) observations of existing tracks."""
+        n0 = len(self.track)
+        self.track = np.concatenate([self.track, np.asarray(track, np.int64)])
+        self.image = np.concatenate([self.image, np.asarray(image, np.int64)])
+        self.xy = np.vstack([self.xy, np.asarray(xy, np.float64).reshape(-1, 2)])
+        self.feature = np.concatenate([self.feature, np.asarray(feature, np.int64)])
+        self.valid = np.concatenate([self.valid, np.ones(len(self.track) - n0, bool)])
+        xn_new = np.empty((len(self.track) - n0, 2))
+        cam_of_obs = self.image_camera[self.image[n0:]]
+        for c, cam in enumerate(self.cameras):
+            idx = np.flatnonzero(cam_of_obs == c)
+            if len(idx):
+                k = Camera.from_params(self.intr[c], cam.width, cam.height, cam.id)
+                xn_new[idx] = undistort_points(self.xy[n0:][idx], k)
+        self.xn = np.vstack([self.xn, xn_new])
+        self._index_tracks()
 
     def normalize(self) -> None:
         self.xn = np.empty_like(self.xy)
@@ -332,6 +383,275 @@ def _resect(st: _State, i: int, cfg: IncrementalConfig):
     return (R, C), len(inl)
 
 
+def _valid_pair_counts(st: _State):
+    """Shared valid observations per image pair: dense (n_img, n_img) int array."""
+    from scipy import sparse
+
+    v = np.flatnonzero(st.valid)
+    A = sparse.csr_matrix(
+        (np.ones(len(v), dtype=np.int32), (st.image[v], st.track[v])), shape=(st.n_img, st.n_tracks)
+    )
+    return np.asarray((A @ A.T).todense())
+
+
+def _point_descriptors(st: _State, features, tracks: np.ndarray, exclude_image: int):
+    """CSR descriptors of the valid observations (in registered images other than ``exclude_image``)."""
+    parts_off = [0]
+    imgs = []
+    feats = []
+    for t in tracks:
+        o = st.track_obs(int(t))
+        o = o[st.valid[o] & st.reg[st.image[o]] & (st.image[o] != exclude_image) & (st.feature[o] >= 0)]
+        imgs.append(st.image[o])
+        feats.append(st.feature[o])
+        parts_off.append(parts_off[-1] + len(o))
+    img = np.concatenate(imgs) if imgs else np.zeros(0, np.int64)
+    fe = np.concatenate(feats) if feats else np.zeros(0, np.int64)
+    dim = features[0].descriptors.shape[1] if len(features) and features[0].descriptors.ndim == 2 else 128
+    desc = np.zeros((len(img), dim), np.float32)
+    for i in np.unique(img):
+        sel = img == i
+        desc[sel] = features[int(i)].descriptors[fe[sel]]
+    return np.array(parts_off, dtype=np.int64), desc
+
+
+def _guided_pairs(st: _State, cfg: IncrementalConfig, attempts: dict):
+    """(image, partner) pairs worth a guided attempt, best linked first, and the pair counts."""
+    g = cfg.guided
+    n_reg = int(st.reg.sum())
+    unreg = np.flatnonzero(~st.reg)
+    reg = np.flatnonzero(st.reg)
+    if len(unreg) == 0 or len(reg) < 2:
+        return [], None
+    S = _valid_pair_counts(st)
+    links = S[np.ix_(unreg, reg)]
+    out = []
+    for a in np.argsort(-links.max(axis=1), kind="stable"):
+        k = int(unreg[a])
+        for p in reg[np.argsort(-links[a], kind="stable")][: g.max_partners]:
+            p = int(p)
+            last = attempts.get((k, p))
+            # a failed pair is tried again once the block has grown by 10 % (at least one image)
+            if S[k, p] >= g.min_partner_tracks and (last is None or n_reg >= max(last + 1, 1.1 * last)):
+                out.append((k, p))
+    return out, S
+
+
+def _guided_register(st: _State, cfg: IncrementalConfig, features, pairs, S, attempts: dict, log: list):
+    """Register one unregistered image by relative orientation + guided scale (module docstring, step 5).
+
+    Returns the registered image index, or None. Every attempt (also a failed one) is appended to
+    ``log``.
+    """
+    n_reg = int(st.reg.sum())
+    for k, p in pairs:
+        attempts[(k, p)] = n_reg
+        entry = _guided_attempt(st, cfg, features, k, p, S)
+        log.append(entry)
+        if entry["registered"]:
+            return k
+    return None
+
+
+def _guided_attempt(st: _State, cfg: IncrementalConfig, features, k: int, p: int, S) -> dict:
+    g = cfg.guided
+    entry: dict = {"image": k, "partner": p, "registered": False}
+    ok_k, ok_p = _shared_tracks(st, k, p)
+    f = float(0.5 * (st.focal[k] + st.focal[p]))
+    R, t, inl, angle = relative_pose(st.xn[ok_k], st.xn[ok_p], f, cfg.ransac_threshold_px, cfg.seed)
+    entry.update(shared=len(ok_k), relative_inliers=int(inl.sum()), median_angle_deg=angle)
+    if R is None or inl.sum() < g.min_partner_tracks:
+        entry["reason"] = "relative orientation to the partner failed"
+        return entry
+    if not angle >= cfg.min_tri_angle_deg:
+        entry["reason"] = f"baseline to the partner too short (median angle {angle:.2f} deg)"
+        return entry
+    Rp, Cp = st.R[p], st.C[p]
+    Rk = R.T @ Rp
+    b = Rp.T @ t
+    T = Rk @ b
+    # search range of the baseline length: the pair's points (at s = 1) lie at depths seen from p
+    n = int(inl.sum())
+    pair = triangulate_tracks(
+        np.arange(0, 2 * n + 1, 2),
+        np.tile([0, 1], n),
+        np.column_stack([st.xn[ok_k[inl]], st.xn[ok_p[inl]]]).reshape(-1, 2),
+        np.stack([Rk, Rp]),
+        np.stack([Cp + b, Cp]),
+        np.array([f, f]),
+    )
+    depth_pair = ((pair.xyz[pair.ok] - Cp) @ Rp.T)[:, 2]
+    obs_p = np.flatnonzero((st.image == p) & st.valid)
+    obs_p = obs_p[st.point_ok[st.track[obs_p]]]
+    depth_p = ((st.X[st.track[obs_p]] - Cp) @ Rp.T)[:, 2]
+    depth_pair, depth_p = depth_pair[depth_pair > 0], depth_p[depth_p > 0]
+    if len(depth_pair) < 5 or len(depth_p) < 5:
+        entry["reason"] = "too few points to bound the baseline length"
+        return entry
+    d0 = float(np.median(depth_pair))
+    s_lo = float(np.percentile(depth_p, 5)) / d0 / g.scale_range_factor
+    s_hi = float(np.percentile(depth_p, 95)) / d0 * g.scale_range_factor
+    # block points that can be in view: those of the partner and of its registered neighbours
+    near = np.flatnonzero(st.reg & (S[p] >= g.min_partner_tracks))
+    near = np.union1d(near, [p])
+    o_near = np.flatnonzero(np.isin(st.image, near) & st.valid)
+    pts = np.unique(st.track[o_near])
+    pts = pts[st.point_ok[pts]]
+    A = (st.X[pts] - Cp) @ Rk.T
+    poff, pdesc = _point_descriptors(st, features, pts, k)
+    cam = Camera.from_params(
+        st.intr[st.image_camera[k]],
+        st.cameras[st.image_camera[k]].width,
+        st.cameras[st.image_camera[k]].height,
+    )
+    fk = features[k]
+    u = undistort_points(np.asarray(fk.xy, np.float64), cam)
+    res = search_scale(A, T, u, float(cam.fx), fk.xy, fk.descriptors, poff, pdesc, (s_lo, s_hi), g, cfg.seed)
+    entry["scale_search"] = res.summary()
+    entry["scale_range"] = [s_lo, s_hi]
+    if not res.ok:
+        entry["reason"] = res.reason
+        return entry
+    Ck = Cp + res.scale * b
+    ver = _verify_guided(st, cfg, k, p, Rk, Ck, pts[res.points], res.features, ok_k[inl], ok_p[inl], features)
+    entry.update({key: v for key, v in ver.items() if key not in ("R", "C", "add_track", "add_feature")})
+    if not ver["ok"]:
+        entry["reason"] = ver["reason"]
+        return entry
+    # commit: the pose, the verified guided matches as observations of their tracks
+    xy_new = np.asarray(fk.xy, np.float64)[ver["add_feature"]]
+    st.add_observations(ver["add_track"], np.full(len(ver["add_track"]), k), xy_new, ver["add_feature"])
+    st.R[k], st.C[k] = ver["R"], ver["C"]
+    st.reg[k] = True
+    entry["registered"] = True
+    entry["points"] = int(ver["guided_inliers"])
+    return entry
+
+
+def _verify_guided(st, cfg, k, p, Rk, Ck, match_tracks, match_feat, pair_k, pair_p, features) -> dict:
+    """Local adjustment of image k alone (the block fixed) on its guided and two-view observations.
+
+    Returns ``ok``, ``reason``, the adjusted pose ``R, C``, the guided matches kept
+    (``add_track``, ``add_feature``), ``guided_inliers``, ``rms_px`` (image k),
+    ``pair_points`` and their ``pair_median_angle_deg``, ``scale_change``.
+    """
+    g = cfg.guided
+    xy_k = np.asarray(features[k].xy, np.float64)
+    # a match is new (track not yet seen in k, feature free), confirms an existing observation of
+    # the track in k (same feature), or conflicts with one (dropped)
+    used = set(st.feature[(st.image == k) & st.valid].tolist())
+    status = np.zeros(len(match_tracks), np.int64)  # 0 drop, 1 new, 2 existing
+    for i, (t, fe) in enumerate(zip(match_tracks, match_feat, strict=True)):
+        o = st.track_obs(int(t))
+        o = o[st.image[o] == k]
+        if len(o) == 0:
+            status[i] = 0 if int(fe) in used else 1
+        elif st.valid[o[0]] and st.feature[o[0]] == fe:
+            status[i] = 2
+    keep = status > 0
+    m_tr, m_fe, m_new = np.asarray(match_tracks)[keep], np.asarray(match_feat)[keep], status[keep] == 1
+    out: dict = {"ok": False, "reason": "", "guided_matches": int(len(m_tr))}
+    if len(m_tr) < g.min_points:
+        out["reason"] = f"{len(m_tr)} guided matches left after removing conflicts with existing observations"
+        return out
+    # points: guided block points (with their registered observations), two-view points of the pair
+    f = float(st.focal[k])
+    n2 = len(pair_k)
+    tri = triangulate_tracks(
+        np.arange(0, 2 * n2 + 1, 2),
+        np.tile([0, 1], n2),
+        np.column_stack([st.xn[pair_k], st.xn[pair_p]]).reshape(-1, 2),
+        np.stack([Rk, st.R[p]]),
+        np.stack([Ck, st.C[p]]),
+        np.array([f, f]),
+    )
+    good2 = tri.ok & (tri.max_error <= cfg.max_reproj_px)
+    obs_img, obs_pt, obs_xy, pts = [], [], [], []
+    for i, t in enumerate(m_tr):
+        o = st.track_obs(int(t))
+        o = o[st.valid[o] & st.reg[st.image[o]] & (st.image[o] != k)]
+        obs_img += [st.image[o], [k]]
+        obs_pt += [np.full(len(o) + 1, i)]
+        obs_xy += [st.xy[o], xy_k[m_fe[i] : m_fe[i] + 1]]
+        pts.append(st.X[t])
+    n_g = len(m_tr)
+    sel2 = np.flatnonzero(good2)
+    for q, j in enumerate(sel2):
+        obs_img += [[k], [p]]
+        obs_pt += [np.full(2, n_g + q)]
+        obs_xy += [st.xy[pair_k[j] : pair_k[j] + 1], st.xy[pair_p[j] : pair_p[j] + 1]]
+        pts.append(tri.xyz[j])
+    img_all = np.concatenate([np.asarray(a, np.int64) for a in obs_img])
+    images = np.unique(img_all)
+    imap = -np.ones(st.n_img, np.int64)
+    imap[images] = np.arange(len(images))
+    R0 = st.R[images].copy()
+    C0 = st.C[images].copy()
+    R0[imap[k]], C0[imap[k]] = Rk, Ck
+    pb = BundleProblem(
+        intrinsics=st.intr,
+        image_camera=st.image_camera[images],
+        rotations=R0,
+        centers=C0,
+        points=np.array(pts).reshape(-1, 3),
+        obs_image=imap[img_all],
+        obs_point=np.concatenate(obs_pt),
+        obs_xy=np.vstack(obs_xy),
+        fixed_images=[int(imap[i]) for i in images if i != k],
+    )
+    res = bundle_adjust(
+        pb,
+        BundleConfig(
+            max_iterations=cfg.ba_iterations,
+            loss="huber",
+            loss_scale=cfg.loss_scale_px,
+            compute_covariance=False,
+        ),
+    )
+    err = np.linalg.norm(res.residuals, axis=1)
+    on_k = pb.obs_image == imap[k]
+    guided_obs = on_k & (pb.obs_point < n_g)
+    e_g = err[guided_obs]
+    inl = e_g <= cfg.max_reproj_px
+    R1, C1 = res.rotations[imap[k]], res.centers[imap[k]]
+    e_k = err[on_k]
+    e_k = e_k[np.isfinite(e_k) & (e_k <= cfg.max_reproj_px)]
+    # intersection angles of the pair's points after the adjustment
+    P2 = res.points[n_g:]
+    r1 = P2 - C1
+    r2 = P2 - st.C[p]
+    cosang = np.sum(r1 * r2, axis=1) / np.maximum(
+        np.linalg.norm(r1, axis=1) * np.linalg.norm(r2, axis=1), 1e-300
+    )
+    ang = np.degrees(np.arccos(np.clip(cosang, -1, 1)))
+    base0 = float(np.linalg.norm(Ck - st.C[p]))
+    out.update(
+        R=R1,
+        C=C1,
+        add_track=m_tr[inl & m_new],
+        add_feature=m_fe[inl & m_new],
+        guided_inliers=int(inl.sum()),
+        rms_px=float(np.sqrt(np.mean(e_k**2))) if len(e_k) else float("nan"),
+        guided_rms_px=float(np.sqrt(np.mean(e_g[inl] ** 2))) if inl.any() else float("nan"),
+        pair_points=int(len(sel2)),
+        pair_median_angle_deg=float(np.median(ang)) if len(ang) else float("nan"),
+        scale_change=float(np.linalg.norm(C1 - st.C[p]) / base0 - 1.0) if base0 > 0 else float("nan"),
+    )
+    if inl.sum() < g.min_points:
+        out["reason"] = (
+            f"{int(inl.sum())} guided matches within {cfg.max_reproj_px} px after the local adjustment"
+        )
+    elif len(sel2) < g.min_partner_tracks:
+        out["reason"] = f"{len(sel2)} two-view points with the partner after triangulation"
+    elif not out["pair_median_angle_deg"] >= cfg.min_tri_angle_deg:
+        out["reason"] = "intersection angle with the partner too small"
+    elif abs(out["scale_change"]) > 0.05:
+        out["reason"] = f"the local adjustment moved the baseline length by {100 * out['scale_change']:.1f} %"
+    else:
+        out["ok"] = True
+    return out
+
+
 def reconstruct(
     obs_track,
     obs_image,
@@ -340,6 +660,8 @@ def reconstruct(
     cameras: list[Camera],
     config: IncrementalConfig | None = None,
     progress: Progress | None = None,
+    features=None,
+    obs_feature=None,
 ) -> Reconstruction:
     """Incremental reconstruction of a block from feature tracks.
 
@@ -353,6 +675,12 @@ def reconstruct(
         Camera index of every image.
     cameras : list of Camera
         Approximate interior orientations (priors; refined by self-calibration).
+    features : list of Features, optional
+        Features of every image (full-resolution ``xy``, ``descriptors``); with
+        ``obs_feature`` they enable the guided registration of weakly
+        connected images (``config.guided``).
+    obs_feature : (M,) int, optional
+        Feature index of every observation in its image's ``features``.
     """
     cfg = config or IncrementalConfig()
     cfg.validate()
@@ -373,9 +701,16 @@ def reconstruct(
         raise InputError("reconstruct: image_camera refers to a missing camera")
     if len(obs_track) == 0 or not np.all(np.isfinite(obs_xy)):
         raise InputError("reconstruct: no (finite) observations: the images share no tie points")
+    guide = features is not None and obs_feature is not None and cfg.guided.enabled
+    if features is not None and len(features) != n_img:
+        raise InputError(f"reconstruct: {len(features)} feature sets for {n_img} images")
+    if obs_feature is not None:
+        obs_feature = np.asarray(obs_feature, dtype=np.int64).reshape(-1)
+        if len(obs_feature) != len(obs_track):
+            raise InputError("reconstruct: obs_feature differs in length from the observations")
 
-    st = _State(obs_track, obs_image, obs_xy, image_camera, cameras)
-    stats: dict = {"registration": [], "adjustments": [], "failed_resections": {}}
+    st = _State(obs_track, obs_image, obs_xy, image_camera, cameras, obs_feature)
+    stats: dict = {"registration": [], "adjustments": [], "failed_resections": {}, "guided": []}
     tried: set = set()
     init = _initial_pair(st, cfg, tried)
     if init is None:
@@ -393,6 +728,8 @@ def reconstruct(
     ]
     last_ba = 2
     failures: dict[int, int] = {}
+    guided_attempts: dict[tuple[int, int], int] = {}
+    calibrated_at = -1
     while True:
         check(prog)
         prog.update(st.reg.sum() / n_img, f"registered {int(st.reg.sum())} of {n_img} images")
@@ -417,10 +754,34 @@ def reconstruct(
             new_tracks = np.unique(st.track[(st.image == k) & st.valid])
             _triangulate(st, new_tracks[~st.point_ok[new_tracks]], cfg)
             break
+        guided_now = False
+        if not registered_one and guide and (~st.reg).any():
+            pairs, S = _guided_pairs(st, cfg, guided_attempts)
+            if pairs and calibrated_at != int(st.reg.sum()) and cfg.refine_intrinsics:
+                # guided matching predicts positions: it needs the interior orientation of the block
+                # (distortion included), not only the focal length of the incremental phase
+                res, n_bad = _bundle(st, cfg, cfg.refine_intrinsics, cfg.ba_iterations)
+                _triangulate(st, np.flatnonzero(~st.point_ok), cfg)
+                stats["adjustments"].append(
+                    {
+                        "images": int(st.reg.sum()),
+                        "rms_px": res.rms,
+                        "rejected": n_bad,
+                        "self_calibration": True,
+                    }
+                )
+                calibrated_at = int(st.reg.sum())
+                pairs, S = _guided_pairs(st, cfg, guided_attempts)
+            k_g = _guided_register(st, cfg, features, pairs, S, guided_attempts, stats["guided"])
+            if k_g is not None:
+                registered_one = guided_now = True
+                stats["registration"].append({"image": int(k_g), "inliers": stats["guided"][-1]["points"]})
+                new_tracks = np.unique(st.track[(st.image == k_g) & st.valid])
+                _triangulate(st, new_tracks[~st.point_ok[new_tracks]], cfg)
         if not registered_one:
             break
         n_reg = int(st.reg.sum())
-        if n_reg <= 6 or n_reg >= last_ba * cfg.ba_growth:
+        if guided_now or n_reg <= 6 or n_reg >= last_ba * cfg.ba_growth:
             refine = (
                 ("f",) if (cfg.refine_focal_early and "f" in cfg.refine_intrinsics and n_reg >= 3) else ()
             )
@@ -455,4 +816,16 @@ def _result(st: _State, stats: dict, t0: float) -> Reconstruction:
     stats["registered"] = int(st.reg.sum())
     stats["points"] = int(st.point_ok.sum())
     valid = st.valid & st.reg[st.image] & st.point_ok[st.track]
-    return Reconstruction(st.reg.copy(), st.R.copy(), st.C.copy(), st.intr.copy(), st.X.copy(), valid, stats)
+    return Reconstruction(
+        st.reg.copy(),
+        st.R.copy(),
+        st.C.copy(),
+        st.intr.copy(),
+        st.X.copy(),
+        valid,
+        stats,
+        st.track.copy(),
+        st.image.copy(),
+        st.xy.copy(),
+        st.feature.copy(),
+    )

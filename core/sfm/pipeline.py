@@ -60,6 +60,9 @@ class OrientConfig:
     refine_intrinsics: tuple[str, ...] = ALL_INTRINSICS
     #: Tie-point decimation grid cell, pixels at full resolution (None: max(w, h) / 50).
     decimation_cell_px: float | None = None
+    #: Every image pair keeps at least this many of its shared tie points through the decimation
+    #: (the links of weakly connected images; see :func:`~.tracks.decimate_tracks`).
+    min_pair_tracks: int = 150
     #: Pair selection strategy: auto, exhaustive, gps, retrieval.
     pair_strategy: str = "auto"
     incremental: IncrementalConfig = field(default_factory=IncrementalConfig)
@@ -286,7 +289,7 @@ def orient_images(
 
     t = time.perf_counter()
     cell = cfg.decimation_cell_px or max(float(sizes.max()) / 50.0, 8.0)
-    tracks = tracks_from_pairs(features, results, cell)
+    tracks = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)
     steps[3].update(1.0, f"{tracks.n_tracks} tie points after decimation")
     times["tracks"] = time.perf_counter() - t
 
@@ -302,7 +305,9 @@ def orient_images(
         inc.refine_focal_early = False
     elif camera_file:
         inc.refine_focal_early = False
-    rec = reconstruct(tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, steps[4])
+    rec = reconstruct(
+        tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, steps[4], features, tracks.feature
+    )
     missing = np.flatnonzero(~rec.registered)
     if len(missing) and sel.strategy != "exhaustive" and rec.registered.sum() >= 2:
         # second chance: match the images left out against every image not paired with them yet
@@ -318,8 +323,18 @@ def orient_images(
             more, _ = match_pairs(features, np.array(extra), per_image_cams)
             results = results + more
             n_verified = sum(r.ok for r in results)
-            tracks2 = tracks_from_pairs(features, results, cell)
-            rec2 = reconstruct(tracks2.track, tracks2.image, tracks2.xy, image_camera, cams, inc, None)
+            tracks2 = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)
+            rec2 = reconstruct(
+                tracks2.track,
+                tracks2.image,
+                tracks2.xy,
+                image_camera,
+                cams,
+                inc,
+                None,
+                features,
+                tracks2.feature,
+            )
             if rec2.registered.sum() > rec.registered.sum():
                 rec, tracks = rec2, tracks2
             stats_extra = {"second_pass_pairs": len(extra), "registered_after": int(rec.registered.sum())}
@@ -333,6 +348,9 @@ def orient_images(
         raise InputError(f"orientation failed: {rec.stats.get('failure', 'no initial pair')}")
     for k in np.flatnonzero(~rec.registered):
         warnings.append(f"image {names[k]} could not be oriented (too few tie points with the block)")
+    warnings += _guided_messages(rec.stats.get("guided", []), names)
+    # the observations of the model: the tracks plus the matches added by guided registration
+    tracks = _model_tracks(tracks, rec)
 
     t = time.perf_counter()
     block, track_ids = block_from_reconstruction(
@@ -412,6 +430,35 @@ def orient_images(
     return OrientationRun(
         orientation, rep, tie["xyz"], tie["multiplicity"], tie["error"], tie["rgb"], residuals
     )
+
+
+def _model_tracks(tracks, rec):
+    """Tracks with the observations of the reconstruction (input ones first, then guided matches)."""
+    from .tracks import Tracks
+
+    if rec.obs_track is None or len(rec.obs_track) == len(tracks.track):
+        return tracks
+    return Tracks(
+        rec.obs_track, rec.obs_image, rec.obs_feature, rec.obs_xy, tracks.n_tracks, dict(tracks.stats)
+    )
+
+
+def _guided_messages(entries: list[dict], names: list[str]) -> list[str]:
+    """One report line per image registered by guided matching (its verification numbers)."""
+    out = []
+    for e in entries:
+        if not e.get("registered"):
+            continue
+        sc = e.get("scale_search", {})
+        out.append(
+            f"image {names[e['image']]} registered by guided matching: relative orientation to "
+            f"{names[e['partner']]} ({e['pair_points']} points, median intersection angle "
+            f"{e['pair_median_angle_deg']:.1f} deg), baseline length from {e['guided_inliers']} guided "
+            f"matches of block points ({sc.get('expected_chance_matches', float('nan')):.2f} expected by "
+            f"chance, log10 NFA {sc.get('log10_nfa', float('nan')):.1f}), reprojection RMS "
+            f"{e['rms_px']:.2f} px"
+        )
+    return out
 
 
 def _adjust_free(block: Block, gcfg: GeorefConfig):

@@ -106,6 +106,39 @@ def orientation_report(
             "Images with 0 observations were not oriented.",
         )
     )
+    guided = [e for e in stats.get("reconstruction", {}).get("guided", []) if e.get("registered")]
+    if guided:
+        rep.tables.append(
+            Table(
+                "Images registered by guided matching",
+                [
+                    "image",
+                    "partner",
+                    "pair points",
+                    "median angle [°]",
+                    "scale points",
+                    "expected by chance",
+                    "log10 NFA",
+                    "RMS [px]",
+                ],
+                [
+                    [
+                        image_names[e["image"]],
+                        image_names[e["partner"]],
+                        e["pair_points"],
+                        e["pair_median_angle_deg"],
+                        e["guided_inliers"],
+                        e["scale_search"]["expected_chance_matches"],
+                        e["scale_search"]["log10_nfa"],
+                        e["rms_px"],
+                    ]
+                    for e in guided
+                ],
+                "Rotation and baseline direction from the relative orientation to the partner; the baseline "
+                "length from guided matches of block points (number, and how many would match by chance); "
+                "pose confirmed by an adjustment of the image alone against the block.",
+            )
+        )
     if cameras:
         cols = ["camera", "fx", "fy", "cx", "cy", "k1", "k2", "k3", "p1", "p2"]
         rep.tables.append(

@@ -18,6 +18,13 @@ no scales are given). The kept set is a set of *tracks*: a track is kept
 when it wins at least one cell of at least one image, and is then kept with
 **all** its observations, so a tie point never disappears from some of the
 images it was measured in (a cell can thus hold several kept observations).
+
+Cell winners favour long tracks, so a pair of images whose only common
+points are two-view tracks (a weakly connected image at the edge of a block,
+a small overlap between strips) can lose most of its links although they are
+the only thing that ties it to the block. With ``min_pair_tracks`` every
+image pair keeps at least ``min(n, min_pair_tracks)`` of the ``n`` tracks it
+shared before the decimation.
 """
 
 from __future__ import annotations
@@ -151,7 +158,9 @@ def build_tracks(n_features, pair_matches, keypoints=None) -> Tracks:
     return t
 
 
-def decimate_tracks(tracks: Tracks, image_sizes, cell_px: float, feature_scale=None) -> Tracks:
+def decimate_tracks(
+    tracks: Tracks, image_sizes, cell_px: float, feature_scale=None, min_pair_tracks: int = 0
+) -> Tracks:
     """Keep the best track per grid cell of every image (see the module docstring).
 
     Parameters
@@ -164,15 +173,22 @@ def decimate_tracks(tracks: Tracks, image_sizes, cell_px: float, feature_scale=N
         Grid cell size, pixels (full resolution).
     feature_scale : list of (N_i,) arrays, optional
         Feature scale (e.g. :attr:`Features.size`) per image, for tie-breaking.
+    min_pair_tracks : int
+        Links of weakly connected images are protected: an image pair that shared ``n`` tracks
+        and keeps fewer than ``min(n, min_pair_tracks)`` gets its best shared tracks back
+        (highest multiplicity, then finest scale) up to that number (0: no protection).
 
     Returns
     -------
     Tracks
         The kept tracks with all their observations; ``stats`` gains
-        ``decimation`` = {cell_px, tracks_before, tracks_after}.
+        ``decimation`` = {cell_px, tracks_before, tracks_after, min_pair_tracks,
+        tracks_restored, pairs_restored}.
     """
     if not (isinstance(cell_px, int | float) and np.isfinite(cell_px) and cell_px > 0):
         raise InputError(f"cell_px must be a positive number, got {cell_px!r}")
+    if not (isinstance(min_pair_tracks, int | np.integer) and min_pair_tracks >= 0):
+        raise InputError(f"min_pair_tracks must be a non-negative integer, got {min_pair_tracks!r}")
     sizes = np.asarray(image_sizes, dtype=np.float64).reshape(-1, 2)
     if tracks.n_tracks == 0:
         return tracks.subset(np.zeros(0, bool))
@@ -201,16 +217,73 @@ def decimate_tracks(tracks: Tracks, image_sizes, cell_px: float, feature_scale=N
     first[1:] = cell[order][1:] != cell[order][:-1]
     keep = np.zeros(tracks.n_tracks, bool)
     keep[tracks.track[order[first]]] = True
+    n_winners = int(keep.sum())
+    n_pairs_restored = 0
+    if min_pair_tracks > 0:
+        # per track: smallest tie-break value over its observations (finer features first)
+        track_tie = np.full(tracks.n_tracks, np.inf)
+        np.minimum.at(track_tie, tracks.track, tie)
+        n_pairs_restored = _restore_pair_links(tracks, keep, int(min_pair_tracks), track_tie)
     out = tracks.subset(keep)
     out.stats["decimation"] = {
         "cell_px": float(cell_px),
         "tracks_before": tracks.n_tracks,
         "tracks_after": out.n_tracks,
+        "min_pair_tracks": int(min_pair_tracks),
+        "tracks_restored": out.n_tracks - n_winners,
+        "pairs_restored": n_pairs_restored,
     }
     return out
 
 
-def tracks_from_pairs(features, pair_results, decimate_cell_px: float | None = None) -> Tracks:
+def _pair_track_counts(image: np.ndarray, track: np.ndarray, n_img: int, n_tracks: int, keep=None):
+    """Shared tracks per image pair ``(i < j)``: sparse COO upper triangle of ``A A^T``."""
+    from scipy import sparse
+
+    sel = np.ones(len(track), bool) if keep is None else keep[track]
+    A = sparse.csr_matrix(
+        (np.ones(int(sel.sum()), np.int32), (image[sel], track[sel])), shape=(n_img, n_tracks)
+    )
+    S = sparse.triu(A @ A.T, k=1).tocsr()
+    return S
+
+
+def _restore_pair_links(tracks: Tracks, keep: np.ndarray, min_pair: int, track_tie: np.ndarray) -> int:
+    """Give back decimated tracks of image pairs left with fewer than ``min_pair`` shared tracks.
+
+    For every pair that shared ``n`` tracks before the decimation and keeps fewer than
+    ``min(n, min_pair)``, its shared tracks of highest multiplicity (then finest scale) are
+    restored until it has ``min(n, min_pair)``. Updates ``keep`` in place; returns the number of
+    pairs that got tracks back.
+    """
+    n_img = int(tracks.image.max()) + 1
+    before = _pair_track_counts(tracks.image, tracks.track, n_img, tracks.n_tracks).tocoo()
+    after = _pair_track_counts(tracks.image, tracks.track, n_img, tracks.n_tracks, keep).tocsr()
+    kept_n = np.asarray(after[before.row, before.col]).ravel()
+    need = np.minimum(before.data, min_pair)
+    deficit = np.flatnonzero(kept_n < need)
+    if len(deficit) == 0:
+        return 0
+    # observations per image, sorted by track, for the intersections
+    mult = tracks.multiplicity
+    per_image = {}
+    for i in np.unique(np.concatenate([before.row[deficit], before.col[deficit]])):
+        per_image[int(i)] = np.unique(tracks.track[tracks.image == i])
+    for k in deficit:
+        i, j = int(before.row[k]), int(before.col[k])
+        shared = np.intersect1d(per_image[i], per_image[j], assume_unique=True)
+        missing = int(need[k]) - int(keep[shared].sum())
+        if missing <= 0:  # an earlier restoration already covered this pair
+            continue
+        cand = shared[~keep[shared]]
+        cand = cand[np.lexsort((cand, track_tie[cand], -mult[cand]))]
+        keep[cand[:missing]] = True
+    return len(deficit)
+
+
+def tracks_from_pairs(
+    features, pair_results, decimate_cell_px: float | None = None, min_pair_tracks: int = 0
+) -> Tracks:
     """Tracks from :func:`~.matching.match_pairs` results (verified pairs only).
 
     Parameters
@@ -219,10 +292,12 @@ def tracks_from_pairs(features, pair_results, decimate_cell_px: float | None = N
     pair_results : list of PairMatches
     decimate_cell_px : float, optional
         Apply :func:`decimate_tracks` with this cell size.
+    min_pair_tracks : int
+        Protection of weak pair links in the decimation (see :func:`decimate_tracks`).
     """
     pm = [(r.i, r.j, r.inliers) for r in pair_results if r.ok]
     t = build_tracks([len(f) for f in features], pm, [f.xy for f in features])
     if decimate_cell_px:
         sizes = [(f.width, f.height) for f in features]
-        t = decimate_tracks(t, sizes, decimate_cell_px, [f.size for f in features])
+        t = decimate_tracks(t, sizes, decimate_cell_px, [f.size for f in features], min_pair_tracks)
     return t

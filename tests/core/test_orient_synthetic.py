@@ -5,7 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from truortho.core.errors import CRSError, InputError
 from truortho.core.formats.gcplist import read_gcp_list
+from truortho.core.orientation import GCP
 from truortho.core.sfm.pipeline import OrientConfig, orient_images
 from truortho.core.synthetic import SceneConfig, make_scene
 
@@ -32,11 +34,27 @@ def test_orientation_accuracy_with_gcps(synthetic_block, tmp_path):
         g.role = truth[g.name].role
     assert sum(g.role == "check" for g in gcps) >= 3
     paths = sorted(str(p) for p in folder.glob("img_*.png"))
-    run = orient_images(paths, gcps=gcps, crs=crs, config=OrientConfig(working_size=640), work_dir=tmp_path)
+    # bad input that must only cost a warning: a non-image file among the images, a GCP without
+    # observations, an observation on an image that is not in the block
+    (folder / "flight_log.txt").write_text("not an image")
+    gcps.append(GCP("lonely", gcps[0].xyz + 5.0, "gcp"))
+    check = next(g for g in gcps if g.role == "check")
+    check.observations.append(("not_in_block.png", 10.0, 20.0))
+    run = orient_images(
+        paths + [str(folder / "flight_log.txt")],
+        gcps=gcps,
+        crs=crs,
+        config=OrientConfig(working_size=640),
+        work_dir=tmp_path,
+    )
     o = run.orientation
     rep = run.report.data
     print("summary", run.report.summary)
     print("check RMSE", rep["check_rmse"], "GSD", gsd)
+    warnings = " | ".join(run.report.warnings)
+    assert "skipped flight_log.txt" in warnings
+    assert "GCP lonely has no image observations" in warnings
+    assert f"GCP {check.name}: observation on image 'not_in_block.png'" in warnings
     assert len(o.images) == len(paths)
     c = rep["check_rmse"]
     assert c["n"] >= 3
@@ -51,8 +69,30 @@ def test_orientation_accuracy_with_gcps(synthetic_block, tmp_path):
 
 
 def test_bad_inputs(tmp_path):
-    from truortho.core.errors import InputError
+    from PIL import Image
 
     (tmp_path / "notes.txt").write_text("not an image")
     with pytest.raises(InputError, match="at least two images"):
         orient_images([tmp_path / "notes.txt"])
+    # one image and a non-image file: still fewer than two images
+    rng = np.random.default_rng(0)
+    noise = []
+    for k in range(3):
+        p = tmp_path / f"noise{k}.png"
+        Image.fromarray(rng.integers(0, 255, (240, 320, 3), dtype=np.uint8)).save(p)
+        noise.append(p)
+    with pytest.raises(InputError, match="at least two images are needed, found 1 readable"):
+        orient_images([noise[0], tmp_path / "notes.txt"])
+    # images that do not overlap
+    with pytest.raises(InputError, match="do not overlap"):
+        orient_images(noise, config=OrientConfig(working_size=320, max_features=500), work_dir=tmp_path)
+    g = GCP("g1", [500000.0, 5600000.0, 100.0], "gcp", None, [("noise0.png", 10.0, 10.0)])
+    # ground control in a geographic CRS (a GCP layer in degrees), or without any CRS
+    with pytest.raises(CRSError, match="geographic"):
+        orient_images(noise, gcps=[g], crs="EPSG:4326")
+    with pytest.raises(InputError, match="GCPS: ground control needs a CRS"):
+        orient_images(noise, gcps=[g])
+    # a GCP whose observations all name images that are not given
+    bad = GCP("g2", [500000.0, 5600000.0, 100.0], "gcp", None, [("elsewhere.jpg", 1.0, 2.0)])
+    with pytest.raises(InputError, match="GCP g2: its observations refer only to unknown images"):
+        orient_images(noise, gcps=[bad], crs="EPSG:32632")

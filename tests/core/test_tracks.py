@@ -117,3 +117,37 @@ def test_decimation_random_block_properties():
 
     for i in range(n_img):
         assert cells(d, i) == cells(t, i)
+
+
+def test_decimation_keeps_the_links_of_a_weakly_connected_image():
+    # images 0-2: a block with dense three-image tracks; images 3-5: a group with its own dense
+    # three-image tracks. The group's only link to the block, image 3 - image 2, is two-view
+    # tracks that lie in cells where the longer tracks win, in image 2 and in image 3.
+    rng = np.random.default_rng(4)
+    n_long, n_weak = 600, 40
+    pos_a = rng.uniform(0, 400, (n_long, 2))
+    pos_b = rng.uniform(0, 400, (n_long, 2))
+    pos_weak = rng.uniform(0, 400, (n_weak, 2))
+    kp = [pos_a, pos_a, np.vstack([pos_a, pos_weak + 0.5]), np.vstack([pos_b, pos_weak]), pos_b, pos_b]
+    idx = np.arange(n_long)
+    same = np.column_stack([idx, idx])
+    weak = np.column_stack([n_long + np.arange(n_weak), n_long + np.arange(n_weak)])
+    pm = [(0, 1, same), (1, 2, same), (3, 4, same), (4, 5, same), (2, 3, weak)]
+    nf = [n_long, n_long, n_long + n_weak, n_long + n_weak, n_long, n_long]
+    t = build_tracks(nf, pm, kp)
+
+    def links(d, i=2, j=3):
+        return len(np.intersect1d(d.track[d.image == i], d.track[d.image == j]))
+
+    sizes = [(400, 400)] * 6
+    plain = decimate_tracks(t, sizes, 20.0)
+    assert links(plain) < n_weak // 2  # the weak pair lost most of its links
+    kept = decimate_tracks(t, sizes, 20.0, min_pair_tracks=30)
+    assert links(kept) == 30  # protection restores it up to min_pair_tracks
+    everything = decimate_tracks(t, sizes, 20.0, min_pair_tracks=100)
+    assert links(everything) == n_weak
+    assert everything.stats["decimation"]["pairs_restored"] >= 1
+    # the block's own pairs had more than the minimum: untouched
+    assert links(kept, 0, 1) == links(plain, 0, 1) and links(kept, 3, 4) == links(plain, 3, 4)
+    with pytest.raises(InputError, match="min_pair_tracks"):
+        decimate_tracks(t, sizes, 20.0, min_pair_tracks=-1)

@@ -28,6 +28,33 @@ def block(tmp_path_factory):
     return scene, root
 
 
+def _tiny_png() -> bytes:
+    import io
+
+    import numpy as np
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(np.zeros((60, 80, 3), np.uint8)).save(buf, format="PNG")
+    return buf.getvalue()
+
+
+def _gcp_layer(folder: Path, crs: str):
+    """A one-point GCP list in ``crs`` imported with truortho:importgcps: (GCP layer, observations)."""
+    (folder / "gcps.txt").write_text(
+        f"{crs}\n8.5 47.3 400.0 10 20 i0.png g1\n8.5 47.3 400.0 12 22 i1.png g1\n"
+    )
+    g = run(
+        "truortho:importgcps",
+        {
+            "INPUT": str(folder / "gcps.txt"),
+            "GCPS": str(folder / "g.gpkg"),
+            "OBSERVATIONS": str(folder / "o.gpkg"),
+        },
+    )
+    return g["GCPS"], g["OBSERVATIONS"]
+
+
 def run(alg, params):
     import processing
 
@@ -48,12 +75,19 @@ def test_orientimages_with_gcps(truortho_provider, block, tmp_path):
             "OBSERVATIONS": str(tmp_path / "o.gpkg"),
         },
     )
+    # the GCP layer in another CRS (geographic): reprojected to the output CRS by the algorithm
+    g4326 = run(
+        "native:reprojectlayer",
+        {"INPUT": g["GCPS"], "TARGET_CRS": "EPSG:4326", "OUTPUT": str(tmp_path / "g4326.gpkg")},
+    )["OUTPUT"]
+    assert QgsVectorLayer(g4326, "g", "ogr").crs().authid() == "EPSG:4326"
     res = run(
         "truortho:orientimages",
         {
             "IMAGES": str(root / "images"),
-            "GCPS": g["GCPS"],
+            "GCPS": g4326,
             "OBSERVATIONS": g["OBSERVATIONS"],
+            "CRS": "EPSG:32632",
             "WORKING_SIZE": 400,
             "ORIENTATION": str(tmp_path / "orientation.json"),
             "REPORT": str(tmp_path / "r.html"),
@@ -90,6 +124,24 @@ def test_orientimages_bad_input(truortho_provider, tmp_path):
             "truortho:orientimages",
             {
                 "IMAGES": str(tmp_path / "one"),
+                "ORIENTATION": str(tmp_path / "o.json"),
+                "REPORT": str(tmp_path / "r.html"),
+                "CAMERAS": "memory:",
+            },
+        )
+    assert not (tmp_path / "o.json").exists()
+    # ground control in a geographic CRS without an output CRS: the block needs metres
+    (tmp_path / "two").mkdir()
+    for k in range(2):
+        (tmp_path / "two" / f"i{k}.png").write_bytes(_tiny_png())
+    gcp = _gcp_layer(tmp_path, "EPSG:4326")
+    with pytest.raises(QgsProcessingException, match="geographic"):
+        run(
+            "truortho:orientimages",
+            {
+                "IMAGES": str(tmp_path / "two"),
+                "GCPS": gcp[0],
+                "OBSERVATIONS": gcp[1],
                 "ORIENTATION": str(tmp_path / "o.json"),
                 "REPORT": str(tmp_path / "r.html"),
                 "CAMERAS": "memory:",
