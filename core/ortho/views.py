@@ -1,0 +1,242 @@
+"""Per-tile visibility of the output cells in every image that may see them.
+
+For one tile (:class:`~truortho.core.grid.Tile`, computed on its outer window):
+
+1. the surface heights of the outer window plus a *margin* (cells outside the
+   tile that may occlude it: a cell at horizontal distance ``d`` from the window
+   can hide a window cell only if it stands more than ``d / tan(max_view_angle)``
+   above the window's lowest cell; the margin is the largest such ``d`` for the
+   surface's height range, and margin cells failing the test are left out of
+   the depth buffer);
+2. the candidate images: those whose footprint (the frame cast onto the
+   planes of the lowest and highest surface height) meets the window;
+3. per candidate: a depth buffer over the image window the tile's cells project
+   into, at ``scale = min(1, oversample * gsd / res)`` buffer pixels per image
+   pixel (so a buffer pixel is the image pixel or, for a coarse output, about
+   one output cell), and the depth test of every cell (:mod:`.zbuffer`);
+4. per candidate and cell: viewing angle, incidence on the surface (normal from
+   the heights, the smaller one-sided difference on each axis so a cell next to
+   a wall keeps the slope of its own roof or ground) and the effective ground
+   resolution of :mod:`.select`.
+
+Cells are usable in an image when visible, in front of the surface (incidence
+below 90 degrees) and seen at most ``max_view_angle`` off nadir. Without
+visibility (``visibility=False``, the conventional orthorectification) a cell
+is usable in every image whose frame contains its projection.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.camera import Camera
+from ..geometry.footprint import footprint_on_plane
+from ..grid import RasterGrid, Tile
+from .surface import PlanTransform
+from .zbuffer import depth_tolerance, point_visibility, project, render_depth
+
+
+@dataclass
+class ViewSetup:
+    """What every tile needs, prepared once (:func:`prepare_views`)."""
+
+    images: list  # orientation Image objects (all of the orientation)
+    cameras: list[Camera]  # camera of each image
+    boxes: np.ndarray  # (n, 4) local xy bounding boxes of the footprints
+    zmin: float  # local heights
+    zmax: float
+    max_view: float  # radians
+    margin_cells: int
+    visibility: bool
+    tol_factor: float
+    oversample: float
+    wall_min: float
+
+
+def image_boxes(images, cameras, zmin: float, zmax: float) -> np.ndarray:
+    """Local plan bounding boxes (n, 4) of every image's footprint between heights zmin and zmax."""
+    out = np.full((len(images), 4), np.nan)
+    for k, (im, cam) in enumerate(zip(images, cameras, strict=True)):
+        pts = []
+        for z in (zmin, zmax):
+            fp = footprint_on_plane(im.R, im.C, cam, z, samples_per_edge=8)
+            if fp is not None:
+                pts.append(fp)
+        if pts:
+            p = np.vstack(pts)
+            out[k] = [p[:, 0].min(), p[:, 1].min(), p[:, 0].max(), p[:, 1].max()]
+    return out
+
+
+def prepare_views(orientation, surface, to_local: PlanTransform, res: float, max_view_deg: float,
+                  visibility: bool, tol_factor: float, oversample: float, wall_min: float,
+                  max_margin_cells: int = 4096) -> ViewSetup:
+    images = list(orientation.images)
+    cams = [orientation.camera_of(im) for im in images]
+    lo, hi = surface.height_range()
+    zmin, zmax = lo - to_local.offset[2], hi - to_local.offset[2]
+    max_view = math.radians(max_view_deg)
+    margin = 0
+    if visibility:
+        margin = int(math.ceil((zmax - zmin) * math.tan(max_view) / res)) + 2
+        margin = min(margin, max_margin_cells)
+    boxes = image_boxes(images, cams, zmin, zmax)
+    return ViewSetup(images, cams, boxes, zmin, zmax, max_view, margin, visibility, tol_factor, oversample,
+                     wall_min)
+
+
+@dataclass
+class TileViews:
+    """Visibility of the outer-window cells of one tile in its candidate images.
+
+    Attributes
+    ----------
+    grid : RasterGrid
+        The outer window.
+    heights : (rows, cols) float64, world heights (NaN = no surface)
+    cands : (K,) int, indices into the orientation's images
+    usable, near_edge : (K, rows, cols) bool
+    uv : (K, rows, cols, 2) float32 full-resolution pixel coordinates
+    eff_res : (K, rows, cols) float32 effective ground resolution (metres)
+    gsd : (K,) float, median pixel footprint (metres) of each candidate over the tile
+    """
+
+    grid: RasterGrid
+    heights: np.ndarray
+    cands: np.ndarray
+    usable: np.ndarray
+    near_edge: np.ndarray
+    uv: np.ndarray
+    eff_res: np.ndarray
+    gsd: np.ndarray
+    triangles: int = 0
+
+
+def _normals(h: np.ndarray, res: float) -> np.ndarray:
+    """Unit normals (rows, cols, 3) from the smaller one-sided differences."""
+    hz = np.where(np.isfinite(h), h, np.nan)
+
+    def d(axis):
+        fwd = np.diff(hz, axis=axis, append=np.nan)
+        bwd = np.diff(hz, axis=axis, prepend=np.nan)
+        a = np.where(np.isnan(fwd), bwd, fwd)
+        b = np.where(np.isnan(bwd), fwd, bwd)
+        out = np.where(np.abs(a) <= np.abs(b), a, b)
+        return np.where(np.isfinite(out), out, 0.0) / res
+
+    dzdx = d(1)
+    dzdy = -d(0)  # rows go south
+    n = np.stack([-dzdx, -dzdy, np.ones_like(dzdx)], axis=-1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local: PlanTransform,
+               workers: int = 1) -> TileViews:
+    """Visibility and view quality of the outer window of ``tile`` (module docstring)."""
+    res = grid.res
+    outer = tile.outer_grid(grid)
+    M = setup.margin_cells
+    region = grid.window(tile.outer[0] - M, tile.outer[1] - M, tile.outer[2] + 2 * M, tile.outer[3] + 2 * M)
+    hreg = surface.heights_on(region)
+    h = hreg[M: M + outer.rows, M: M + outer.cols]
+    rows, cols = h.shape
+    valid = np.isfinite(h)
+    X, Y = outer.centres()
+    lx, ly = to_local.xy(X, Y)
+    lz = h - to_local.offset[2]
+    P = np.column_stack([lx.ravel(), ly.ravel(), np.where(valid, lz, 0.0).ravel()])
+    vflat = valid.ravel()
+    empty = TileViews(outer, h, np.zeros(0, np.int64), np.zeros((0, rows, cols), bool),
+                      np.zeros((0, rows, cols), bool), np.zeros((0, rows, cols, 2), np.float32),
+                      np.zeros((0, rows, cols), np.float32), np.zeros(0))
+    if not vflat.any():
+        return empty
+    bx0, by0 = float(lx[valid].min()), float(ly[valid].min())
+    bx1, by1 = float(lx[valid].max()), float(ly[valid].max())
+    b = setup.boxes
+    with np.errstate(invalid="ignore"):
+        hit = (b[:, 0] <= bx1) & (b[:, 2] >= bx0) & (b[:, 1] <= by1) & (b[:, 3] >= by0)
+    cand_all = np.flatnonzero(hit)
+    if not len(cand_all):
+        return empty
+    tris = None
+    if setup.visibility:
+        zlow = float(np.nanmin(h))
+        rr, cc = np.mgrid[0:region.rows, 0:region.cols]
+        dr = np.maximum(np.maximum(M - rr, rr - (M + rows - 1)), 0)
+        dc = np.maximum(np.maximum(M - cc, cc - (M + cols - 1)), 0)
+        dist = np.hypot(dr, dc) * res
+        with np.errstate(invalid="ignore"):
+            include = (dist == 0) | (hreg - zlow > dist / math.tan(setup.max_view) - res)
+        tris = surface.triangles(region, hreg, include, to_local, setup.wall_min)
+    normals = _normals(h, res).reshape(-1, 3)
+
+    def one(k):
+        im = setup.images[k]
+        cam = setup.cameras[k]
+        d = im.C[None, :] - P
+        dist = np.linalg.norm(d, axis=1)
+        ray = d / np.maximum(dist, 1e-9)[:, None]
+        cos_view = ray[:, 2]
+        ok = vflat & (cos_view >= math.cos(setup.max_view))
+        if not ok.any():
+            return None
+        gsd = float(np.median(dist[ok] / cam.fx))
+        scale = min(1.0, setup.oversample * gsd / res) if setup.visibility else 1.0
+        # cells projected with the full camera to find the buffer window
+        uvz = project(P[ok], im.R, im.C, cam)
+        uvp, depth = uvz[:, :2], uvz[:, 2]
+        inside = (depth > 0) & (uvp[:, 0] >= -0.5) & (uvp[:, 0] <= cam.width - 0.5) & (uvp[:, 1] >= -0.5) & (
+            uvp[:, 1] <= cam.height - 0.5)
+        if not inside.any():
+            return None
+        idx = np.flatnonzero(ok)[inside]
+        uvb = (uvp[inside] + 0.5) * scale - 0.5
+        bw = max(1, int(round(cam.width * scale)))
+        bh = max(1, int(round(cam.height * scale)))
+        x0 = max(int(math.floor(uvb[:, 0].min())) - 2, 0)
+        y0 = max(int(math.floor(uvb[:, 1].min())) - 2, 0)
+        x1 = min(int(math.ceil(uvb[:, 0].max())) + 2, bw - 1)
+        y1 = min(int(math.ceil(uvb[:, 1].max())) + 2, bh - 1)
+        win = (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
+        Pk = P[idx]
+        tan_view = np.sqrt(np.maximum(1.0 - cos_view[idx] ** 2, 0.0)) / np.maximum(cos_view[idx], 1e-6)
+        usable = np.zeros(len(P), bool)
+        edge = np.zeros(len(P), bool)
+        uv = np.full((len(P), 2), np.nan, np.float32)
+        if setup.visibility:
+            zb = render_depth(tris, im.R, im.C, cam, win, scale)
+            foot = dist[idx] / (cam.fx * scale) / np.maximum(cos_view[idx], 1e-6)
+            tol = depth_tolerance(res, foot, tan_view, setup.tol_factor)
+            vis, ne, uvk, _ = point_visibility(Pk, tol, im.R, im.C, cam, zb, win, scale)
+            usable[idx] = vis
+            edge[idx] = ne & vis
+            uv[idx] = uvk
+        else:
+            usable[idx] = True
+            uv[idx] = uvp[inside]
+        cos_inc = np.einsum("ij,ij->i", normals, ray)
+        usable &= cos_inc > 0.02
+        eff = np.where(usable, dist / (cam.fx * np.maximum(cos_inc, 0.02)), np.inf).astype(np.float32)
+        return usable, edge, uv, eff, gsd
+
+    if workers > 1 and len(cand_all) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(max_workers=workers) as ex:
+            results = list(ex.map(one, cand_all))
+    else:
+        results = [one(k) for k in cand_all]
+    keep = [i for i, r in enumerate(results) if r is not None and r[0].any()]
+    if not keep:
+        return empty
+    K = len(keep)
+    usable = np.stack([results[i][0] for i in keep]).reshape(K, rows, cols)
+    edge = np.stack([results[i][1] for i in keep]).reshape(K, rows, cols)
+    uv = np.stack([results[i][2] for i in keep]).reshape(K, rows, cols, 2)
+    eff = np.stack([results[i][3] for i in keep]).reshape(K, rows, cols)
+    gsd = np.array([results[i][4] for i in keep])
+    return TileViews(outer, h, cand_all[keep], usable, edge, uv, eff, gsd, 0 if tris is None else len(tris))

@@ -1,0 +1,448 @@
+"""Depth buffers of a triangulated surface and the per-cell visibility test.
+
+The surface is a set of generic triangles (:class:`Triangles`: vertices in the
+*local* frame of the orientation, faces as vertex indices), so a DSM and a mesh
+are the same input:
+
+* :func:`dsm_triangles` turns a height grid into the boundary of the union of
+  its cell columns: every cell is a flat square top at its height (two
+  triangles) and every edge between neighbouring cells whose heights differ by
+  more than ``wall_min`` becomes a vertical wall quad (two triangles) from the
+  lower to the higher top. The result is watertight up to the steps below
+  ``wall_min`` and exact at cell centres: the surface point of a cell (its
+  centre at its height) lies on its own top face.
+* a mesh gives its triangles directly (:mod:`.surface`).
+
+Winding: faces are counter-clockwise seen from outside (tops face up, walls face
+the lower cell). A front face projects to a *negative* signed area in pixel
+coordinates (x right, y down), which :func:`render_depth` uses for back-face
+culling.
+
+:func:`render_depth` rasterises the triangles into one image's depth buffer
+(camera z, metres, of the nearest surface at every buffer pixel centre, inf where
+nothing is drawn) over a window of the image, with frustum culling (faces behind
+the camera, outside the window or beyond the valid field of the distortion
+model are skipped) and optional back-face culling; depth is interpolated
+perspective-correctly (``1/z`` is linear in the image). The buffer may be
+coarser than the image (``scale`` < 1, pixel centres mapping as in
+:meth:`~truortho.core.geometry.camera.Camera.scaled`).
+
+:func:`point_visibility` projects cell surface points into the buffer: a point
+is *visible* when its depth ``z`` satisfies ``z <= zbuf + tol`` at the buffer
+pixel nearest to its projection, and *near an occlusion edge* when some pixel of
+the 3 x 3 neighbourhood holds a surface closer than ``z - tol`` (the image
+colour sampled there may mix in the occluder). The tolerance ``tol`` is given
+per point by the caller (:func:`depth_tolerance`): it grows with the cell size,
+the buffer's pixel footprint and the tangent of the viewing angle, because the
+depth of a flat-topped stair approximation of a smooth surface differs from the
+true surface by up to that much within one buffer pixel.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.camera import Camera
+from ..jit import njit
+
+
+@dataclass
+class Triangles:
+    """A triangle soup in the local frame.
+
+    Attributes
+    ----------
+    vertices : (N, 3) float64
+        Local coordinates (``world - offset``), metres.
+    faces : (M, 3) int32
+        Vertex indices, counter-clockwise seen from outside when ``oriented``.
+    oriented : bool
+        The winding is consistent (back-face culling allowed).
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    oriented: bool = True
+
+    def __post_init__(self) -> None:
+        v = np.ascontiguousarray(np.asarray(self.vertices, dtype=np.float64))
+        f = np.ascontiguousarray(np.asarray(self.faces, dtype=np.int32))
+        if v.ndim != 2 or v.shape[1] != 3:
+            raise InputError(f"triangles: vertices must have shape (N, 3), got {v.shape}")
+        if f.ndim != 2 or f.shape[1] != 3:
+            raise InputError(f"triangles: faces must have shape (M, 3), got {f.shape}")
+        if len(f) and (f.min() < 0 or f.max() >= len(v)):
+            raise InputError("triangles: a face refers to a vertex index out of range")
+        self.vertices = v
+        self.faces = f
+
+    def __len__(self) -> int:
+        return len(self.faces)
+
+
+# ---------------------------------------------------------------- DSM -> triangles
+
+
+def dsm_triangles(heights, x_min: float, y_max: float, res: float, include=None, wall_min: float = 0.0):
+    """Triangles of a height grid: flat cell tops plus vertical walls at steps.
+
+    Parameters
+    ----------
+    heights : (rows, cols) float
+        Surface heights at the cells (local z, metres); NaN = no data (no top,
+        no wall).
+    x_min, y_max : float
+        Local coordinates of the outer north-west corner of cell (0, 0).
+    res : float
+        Cell size, metres.
+    include : (rows, cols) bool, optional
+        Cells whose top is emitted (default all valid cells). A wall is emitted
+        when at least one of its two cells is included and both are valid.
+    wall_min : float
+        Height steps up to this value (metres) get no wall.
+
+    Returns
+    -------
+    Triangles
+        Vertex ``4 * (r * cols + c) + k`` is corner ``k`` (NW, NE, SE, SW) of
+        cell ``(r, c)`` at its height.
+    """
+    h = np.asarray(heights, dtype=np.float64)
+    if h.ndim != 2:
+        raise InputError(f"dsm_triangles: heights must be 2-D, got shape {h.shape}")
+    if not res > 0:
+        raise InputError(f"dsm_triangles: res must be positive, got {res!r}")
+    rows, cols = h.shape
+    valid = np.isfinite(h)
+    inc = valid if include is None else (np.asarray(include, dtype=bool) & valid)
+    xs = x_min + np.arange(cols + 1) * res
+    ys = y_max - np.arange(rows + 1) * res
+    verts = np.empty((rows, cols, 4, 3))
+    hz = np.where(valid, h, 0.0)
+    verts[:, :, 0, 0] = xs[None, :-1]
+    verts[:, :, 0, 1] = ys[:-1, None]
+    verts[:, :, 1, 0] = xs[None, 1:]
+    verts[:, :, 1, 1] = ys[:-1, None]
+    verts[:, :, 2, 0] = xs[None, 1:]
+    verts[:, :, 2, 1] = ys[1:, None]
+    verts[:, :, 3, 0] = xs[None, :-1]
+    verts[:, :, 3, 1] = ys[1:, None]
+    verts[:, :, :, 2] = hz[:, :, None]
+    base = (4 * np.arange(rows * cols, dtype=np.int64)).reshape(rows, cols)
+    NW, NE, SE, SW = 0, 1, 2, 3
+    parts = []
+    b = base[inc]
+    parts.append(np.column_stack([b + NW, b + SW, b + SE]))
+    parts.append(np.column_stack([b + NW, b + SE, b + NE]))
+    # walls between (r, c) = A and (r, c + 1) = B on A's east edge
+    if cols > 1:
+        ha, hb = h[:, :-1], h[:, 1:]
+        both = valid[:, :-1] & valid[:, 1:] & (inc[:, :-1] | inc[:, 1:])
+        with np.errstate(invalid="ignore"):
+            step = both & (np.abs(ha - hb) > wall_min)
+        a = base[:, :-1][step]
+        bb = base[:, 1:][step]
+        # the same index triples face +x when A is higher and -x when B is higher
+        a_ne, a_se, b_nw, b_sw = a + NE, a + SE, bb + NW, bb + SW
+        parts += [np.column_stack([b_sw, b_nw, a_ne]), np.column_stack([b_sw, a_ne, a_se])]
+    # walls between (r, c) = A and (r + 1, c) = B on A's south edge
+    if rows > 1:
+        ha, hb = h[:-1, :], h[1:, :]
+        both = valid[:-1, :] & valid[1:, :] & (inc[:-1, :] | inc[1:, :])
+        with np.errstate(invalid="ignore"):
+            step = both & (np.abs(ha - hb) > wall_min)
+        a = base[:-1, :][step]
+        bb = base[1:, :][step]
+        # faces -y when A is higher, +y when B is higher
+        a_sw, a_se, b_nw, b_ne = a + SW, a + SE, bb + NW, bb + NE
+        parts += [np.column_stack([b_nw, b_ne, a_se]), np.column_stack([b_nw, a_se, a_sw])]
+    faces = np.concatenate(parts).astype(np.int32) if parts else np.zeros((0, 3), np.int32)
+    return Triangles(verts.reshape(-1, 3), faces, oriented=True)
+
+
+def face_normals(tris: Triangles) -> np.ndarray:
+    """Unit outward normals (M, 3) of the faces (counter-clockwise winding)."""
+    v = tris.vertices[tris.faces]
+    n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+
+
+# ---------------------------------------------------------------- camera helpers
+
+
+def scaled_params(camera: Camera, scale: float) -> np.ndarray:
+    """Kernel parameters ``[fx, fy, cx, cy, k1, k2, k3, p1, p2]`` of a buffer ``scale`` x the image.
+
+    Pixel centres map as ``x' = (x + 0.5) * scale - 0.5`` (:meth:`Camera.scaled`).
+    """
+    p = camera.params.copy()
+    s = float(scale)
+    p[0] *= s
+    p[1] *= s
+    p[2] = (p[2] + 0.5) * s - 0.5
+    p[3] = (p[3] + 0.5) * s - 0.5
+    return p
+
+
+def valid_radius2(camera: Camera, margin: float = 3.0) -> float:
+    """Largest squared normalised radius where the distortion model is trusted.
+
+    ``margin`` times the radius of the farthest image corner (faces reaching
+    beyond the frame still clip correctly), limited to where the radial model
+    ``r (1 + k1 r^2 + k2 r^4 + k3 r^6)`` stops increasing: beyond that radius
+    far-away points would fold back into the frame.
+    """
+    corners = np.array([[-0.5, -0.5], [camera.width - 0.5, -0.5], [-0.5, camera.height - 0.5],
+                        [camera.width - 0.5, camera.height - 0.5]])
+    xy = np.column_stack([(corners[:, 0] - camera.cx) / camera.fx, (corners[:, 1] - camera.cy) / camera.fy])
+    r_corner = float(np.max(np.hypot(xy[:, 0], xy[:, 1])))
+    r = np.linspace(0.0, max(10.0, 2 * margin * r_corner), 40001)
+    r2 = r * r
+    f = r * (1 + r2 * (camera.k1 + r2 * (camera.k2 + r2 * camera.k3)))
+    bad = np.flatnonzero(np.diff(f) <= 0)
+    r_mono = float(r[bad[0]]) if len(bad) else np.inf
+    rr = min(margin * r_corner, 0.98 * r_mono) if r_mono > r_corner else r_corner
+    return rr * rr
+
+
+# ---------------------------------------------------------------- kernels
+
+
+@njit
+def _proj(x, y, z, R, C, p, r2max):
+    """Pixel ``(u, v)`` and camera depth of a local point; depth <= 0 when unusable."""
+    dx = x - C[0]
+    dy = y - C[1]
+    dz = z - C[2]
+    zc = R[2, 0] * dx + R[2, 1] * dy + R[2, 2] * dz
+    if zc <= 1e-6:
+        return 0.0, 0.0, -1.0
+    xn = (R[0, 0] * dx + R[0, 1] * dy + R[0, 2] * dz) / zc
+    yn = (R[1, 0] * dx + R[1, 1] * dy + R[1, 2] * dz) / zc
+    r2 = xn * xn + yn * yn
+    if r2 > r2max:
+        return 0.0, 0.0, -1.0
+    radial = 1.0 + r2 * (p[4] + r2 * (p[5] + r2 * p[6]))
+    xd = xn * radial + 2.0 * p[7] * xn * yn + p[8] * (r2 + 2.0 * xn * xn)
+    yd = yn * radial + p[7] * (r2 + 2.0 * yn * yn) + 2.0 * p[8] * xn * yn
+    return p[0] * xd + p[2], p[1] * yd + p[3], zc
+
+
+@njit
+def _project_vertices(verts, R, C, p, r2max, uvz):
+    for i in range(verts.shape[0]):
+        u, v, z = _proj(verts[i, 0], verts[i, 1], verts[i, 2], R, C, p, r2max)
+        uvz[i, 0] = u
+        uvz[i, 1] = v
+        uvz[i, 2] = z
+
+
+@njit
+def _rasterise(uvz, faces, x0, y0, zbuf, cull):
+    """Min-depth rasterisation of faces into ``zbuf`` (window origin ``(x0, y0)`` in buffer pixels)."""
+    H = zbuf.shape[0]
+    W = zbuf.shape[1]
+    drawn = 0
+    for f in range(faces.shape[0]):
+        a = faces[f, 0]
+        b = faces[f, 1]
+        c = faces[f, 2]
+        za = uvz[a, 2]
+        zb = uvz[b, 2]
+        zc = uvz[c, 2]
+        if za <= 0.0 or zb <= 0.0 or zc <= 0.0:
+            continue
+        ua = uvz[a, 0] - x0
+        va = uvz[a, 1] - y0
+        ub = uvz[b, 0] - x0
+        vb = uvz[b, 1] - y0
+        uc = uvz[c, 0] - x0
+        vc = uvz[c, 1] - y0
+        area = (ub - ua) * (vc - va) - (uc - ua) * (vb - va)
+        if area == 0.0 or (cull and area > 0.0):
+            continue
+        umin = min(ua, min(ub, uc))
+        umax = max(ua, max(ub, uc))
+        vmin = min(va, min(vb, vc))
+        vmax = max(va, max(vb, vc))
+        i0 = max(np.int64(math.ceil(umin)), 0)
+        i1 = min(np.int64(math.floor(umax)), W - 1)
+        j0 = max(np.int64(math.ceil(vmin)), 0)
+        j1 = min(np.int64(math.floor(vmax)), H - 1)
+        if i0 > i1 or j0 > j1:
+            continue
+        inv = 1.0 / area
+        iza = 1.0 / za
+        izb = 1.0 / zb
+        izc = 1.0 / zc
+        for j in range(j0, j1 + 1):
+            py = float(j)
+            for i in range(i0, i1 + 1):
+                px = float(i)
+                w0 = ((ub - px) * (vc - py) - (uc - px) * (vb - py)) * inv
+                w1 = ((uc - px) * (va - py) - (ua - px) * (vc - py)) * inv
+                w2 = 1.0 - w0 - w1
+                if w0 < -1e-9 or w1 < -1e-9 or w2 < -1e-9:
+                    continue
+                iz = w0 * iza + w1 * izb + w2 * izc
+                if iz <= 0.0:
+                    continue
+                z = 1.0 / iz
+                if z < zbuf[j, i]:
+                    zbuf[j, i] = z
+                    drawn += 1
+    return drawn
+
+
+@njit
+def _visibility(P, tol, R, C, p, r2max, zbuf, x0, y0, vis, edge, u_out, v_out, z_out):
+    """Depth test of points against a buffer window; pixel coordinates in buffer units."""
+    H = zbuf.shape[0]
+    W = zbuf.shape[1]
+    for n in range(P.shape[0]):
+        vis[n] = 0
+        edge[n] = 0
+        u, v, z = _proj(P[n, 0], P[n, 1], P[n, 2], R, C, p, r2max)
+        u_out[n] = u
+        v_out[n] = v
+        z_out[n] = z
+        if z <= 0.0:
+            continue
+        i = np.int64(math.floor(u - x0 + 0.5))
+        j = np.int64(math.floor(v - y0 + 0.5))
+        if i < 0 or j < 0 or i >= W or j >= H:
+            continue
+        t = tol[n]
+        if z <= zbuf[j, i] + t:
+            vis[n] = 1
+        zmin = np.inf
+        for dj in range(-1, 2):
+            jj = j + dj
+            if jj < 0 or jj >= H:
+                continue
+            for di in range(-1, 2):
+                ii = i + di
+                if ii < 0 or ii >= W:
+                    continue
+                if zbuf[jj, ii] < zmin:
+                    zmin = zbuf[jj, ii]
+        if zmin < z - t:
+            edge[n] = 1
+
+
+# ---------------------------------------------------------------- public API
+
+
+def _pose(R, C):
+    Rm = np.ascontiguousarray(np.asarray(R, dtype=np.float64))
+    Cv = np.ascontiguousarray(np.asarray(C, dtype=np.float64).reshape(-1))
+    if Rm.shape != (3, 3) or Cv.shape != (3,):
+        raise InputError("depth buffer: R must be 3x3 and C a 3-vector")
+    return Rm, Cv
+
+
+def project(points, R, C, camera: Camera, scale: float = 1.0) -> np.ndarray:
+    """``(u, v, depth)`` (N, 3) of local points (buffer pixels at ``scale``); depth -1 when unusable.
+
+    Unusable: behind the camera or beyond the valid field of the distortion model
+    (:func:`valid_radius2`).
+    """
+    Rm, Cv = _pose(R, C)
+    P = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+    uvz = np.empty((len(P), 3))
+    _project_vertices(P, Rm, Cv, scaled_params(camera, scale), valid_radius2(camera), uvz)
+    return uvz
+
+
+def render_depth(tris: Triangles, R, C, camera: Camera, window, scale: float = 1.0,
+                 cull: bool | None = None) -> np.ndarray:
+    """Depth buffer of the triangles in one image window.
+
+    Parameters
+    ----------
+    tris : Triangles
+        Local frame.
+    R, C : world-to-camera rotation (3, 3) and projection centre (3,), local frame.
+    camera : Camera
+    window : (x0, y0, width, height)
+        Buffer pixels ``x0 .. x0 + width - 1`` (columns) and rows likewise, in
+        buffer pixel coordinates (``scale`` x the image).
+    scale : float
+        Buffer pixels per image pixel (<= 1 for a coarser buffer).
+    cull : bool, optional
+        Back-face culling; default ``tris.oriented``.
+
+    Returns
+    -------
+    (height, width) float32
+        Camera z (metres) of the nearest surface at each buffer pixel centre;
+        inf where no face is drawn.
+    """
+    Rm, Cv = _pose(R, C)
+    x0, y0, w, h = (int(v) for v in window)
+    if w < 1 or h < 1:
+        raise InputError(f"render_depth: window must have a positive size, got {window!r}")
+    p = scaled_params(camera, scale)
+    uvz = np.empty((len(tris.vertices), 3))
+    _project_vertices(tris.vertices, Rm, Cv, p, valid_radius2(camera), uvz)
+    zbuf = np.full((h, w), np.inf, np.float32)
+    _rasterise(uvz, tris.faces, float(x0), float(y0), zbuf, bool(tris.oriented if cull is None else cull))
+    return zbuf
+
+
+def point_visibility(points, tol, R, C, camera: Camera, zbuf: np.ndarray, window, scale: float = 1.0):
+    """Depth test of surface points against a buffer from :func:`render_depth`.
+
+    Parameters
+    ----------
+    points : (N, 3) float64
+        Local surface points (cell centres at their heights).
+    tol : (N,) or scalar float
+        Depth tolerance, metres (:func:`depth_tolerance`).
+    R, C, camera, scale : as for :func:`render_depth`.
+    zbuf : (h, w) float32 and window : (x0, y0, w, h) of the buffer.
+
+    Returns
+    -------
+    visible : (N,) bool
+        In front, inside the buffer window and not hidden.
+    near_edge : (N,) bool
+        A surface closer than ``z - tol`` lies within one buffer pixel.
+    uv : (N, 2) float64
+        Pixel coordinates in the *full-resolution* image.
+    depth : (N,) float64
+        Camera z, metres (<= 0: behind the camera or outside the valid field).
+    """
+    Rm, Cv = _pose(R, C)
+    P = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+    n = len(P)
+    t = np.ascontiguousarray(np.broadcast_to(np.asarray(tol, dtype=np.float64), (n,)))
+    x0, y0, w, h = (int(v) for v in window)
+    if zbuf.shape != (h, w):
+        raise InputError(f"point_visibility: buffer of shape {zbuf.shape} for a window of {w} x {h}")
+    vis = np.empty(n, np.uint8)
+    edge = np.empty(n, np.uint8)
+    u = np.empty(n)
+    v = np.empty(n)
+    z = np.empty(n)
+    _visibility(P, t, Rm, Cv, scaled_params(camera, scale), valid_radius2(camera), zbuf, float(x0), float(y0),
+                vis, edge, u, v, z)
+    s = float(scale)
+    uv = np.column_stack([(u + 0.5) / s - 0.5, (v + 0.5) / s - 0.5])
+    return vis.astype(bool), edge.astype(bool), uv, z
+
+
+def depth_tolerance(res: float, pixel_footprint, tan_view, factor: float = 1.0) -> np.ndarray:
+    """Depth tolerance (metres) of the visibility test.
+
+    ``factor * max(res, pixel_footprint) * (1 + tan_view)``: within one buffer
+    pixel of footprint ``pixel_footprint`` (metres on the ground) the depth of a
+    surface seen at off-nadir angle ``atan(tan_view)`` varies by about
+    ``pixel_footprint * tan_view``, and the flat cell tops of a DSM of cell size
+    ``res`` deviate from a sloped surface by up to a cell step.
+    """
+    return factor * np.maximum(float(res), pixel_footprint) * (1.0 + np.asarray(tan_view))
