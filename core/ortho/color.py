@@ -246,12 +246,17 @@ def _solve(ia, ib, xa, xb, w, n, prior):
     Unknowns ``[g_0 .. g_{n-1}, o_0 .. o_{n-1}]`` of normalised values; residual
     ``g_a xa + o_a - g_b xb - o_b``.
     """
-    N = np.zeros((2 * n, 2 * n))
+    m = 2 * n
     cols = [ia, n + ia, ib, n + ib]
     coef = [xa, np.ones_like(xa), -xb, -np.ones_like(xb)]
+    flat = np.zeros(m * m)
     for p in range(4):
-        for q in range(4):
-            np.add.at(N, (cols[p], cols[q]), w * coef[p] * coef[q])
+        for q in range(p, 4):
+            v = np.bincount(cols[p] * m + cols[q], weights=w * coef[p] * coef[q], minlength=m * m)
+            flat += v
+            if q != p:
+                flat += v.reshape(m, m).T.ravel()
+    N = flat.reshape(m, m)
     rhs = np.zeros(2 * n)
     lam = prior * max(float(np.sum(w)) / n, 1.0)
     idx = np.arange(2 * n)

@@ -80,6 +80,10 @@ class TrueOrthoConfig:
         Selection energy (:mod:`.select`): penalty for a cell next to an
         occluder, seam weight, weight of the luminance disagreement in a seam,
         height step (m) of a discontinuity, ICM sweeps.
+    edge_shift : float
+        Cells next to a height discontinuity take their colour this many cells
+        inside their own side (0 = at the cell centre), so building outlines do
+        not mix roof and ground colours.
     wall_min : float, optional
         Height steps of the DSM below this (m) get no wall in the depth buffer;
         default a quarter of the cell size.
@@ -109,10 +113,11 @@ class TrueOrthoConfig:
     contrast: float = 4.0
     discontinuity: float = 0.5
     sweeps: int = 8
+    edge_shift: float = 0.75
     wall_min: float | None = None
     zbuffer_oversample: float = 1.0
     image_cache_mb: int = 1024
-    color_cells: int = 200_000
+    color_cells: int = 60_000
     workers: int = 2
     cog: bool = True
 
@@ -260,7 +265,7 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
     to_local.xy(np.array([gx0, gx1, gx0, gx1, 0.5 * (gx0 + gx1)]), np.array([gy0, gy0, gy1, gy1, 0.5 * (gy0 + gy1)]))
     wall_min = cfg.wall_min if cfg.wall_min is not None else 0.25 * res
     setup = prepare_views(o, surf, to_local, res, cfg.max_view_angle, cfg.visibility, cfg.depth_tolerance,
-                          cfg.zbuffer_oversample, wall_min)
+                          cfg.zbuffer_oversample, wall_min, cfg.discontinuity, cfg.edge_shift)
     # ---- images that can contribute: on disk, one band count and dtype
     ex_x, ex_y = to_local.xy(np.array([gx0, gx1, gx0, gx1]), np.array([gy0, gy0, gy1, gy1]))
     b = setup.boxes

@@ -54,6 +54,8 @@ class ViewSetup:
     tol_factor: float
     oversample: float
     wall_min: float
+    discontinuity: float = 1.0  # height step (m) of a building outline for the edge shift
+    edge_shift: float = 0.75  # cells
 
 
 def image_boxes(images, cameras, zmin: float, zmax: float) -> np.ndarray:
@@ -73,6 +75,7 @@ def image_boxes(images, cameras, zmin: float, zmax: float) -> np.ndarray:
 
 def prepare_views(orientation, surface, to_local: PlanTransform, res: float, max_view_deg: float,
                   visibility: bool, tol_factor: float, oversample: float, wall_min: float,
+                  discontinuity: float = 0.5, edge_shift: float = 0.75,
                   max_margin_cells: int = 4096) -> ViewSetup:
     images = list(orientation.images)
     cams = [orientation.camera_of(im) for im in images]
@@ -85,7 +88,7 @@ def prepare_views(orientation, surface, to_local: PlanTransform, res: float, max
         margin = min(margin, max_margin_cells)
     boxes = image_boxes(images, cams, zmin, zmax)
     return ViewSetup(images, cams, boxes, zmin, zmax, max_view, margin, visibility, tol_factor, oversample,
-                     wall_min)
+                     wall_min, max(float(discontinuity), 2.0 * res), float(edge_shift))
 
 
 @dataclass
@@ -133,6 +136,36 @@ def _normals(h: np.ndarray, res: float) -> np.ndarray:
     return n / np.linalg.norm(n, axis=-1, keepdims=True)
 
 
+def edge_shift(h: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Unit plan vectors (rows, cols) ``(dx, dy)`` pointing away from neighbouring height discontinuities.
+
+    A cell whose 4-neighbour differs in height by more than ``step`` gets the
+    (normalised) sum of the unit vectors from such neighbours towards itself;
+    other cells get 0. x is east, y north.
+    """
+    hz = np.where(np.isfinite(h), h, np.nan)
+    dx = np.zeros(h.shape)
+    dy = np.zeros(h.shape)
+    with np.errstate(invalid="ignore"):
+        jump_e = np.zeros(h.shape, bool)
+        jump_e[:, :-1] = ~(np.abs(hz[:, 1:] - hz[:, :-1]) <= step)  # neighbour to the east differs
+        jump_w = np.zeros(h.shape, bool)
+        jump_w[:, 1:] = jump_e[:, :-1]
+        jump_s = np.zeros(h.shape, bool)
+        jump_s[:-1, :] = ~(np.abs(hz[1:, :] - hz[:-1, :]) <= step)  # neighbour to the south (next row)
+        jump_n = np.zeros(h.shape, bool)
+        jump_n[1:, :] = jump_s[:-1, :]
+    dx -= jump_e
+    dx += jump_w
+    dy += jump_s
+    dy -= jump_n
+    n = np.hypot(dx, dy)
+    ok = n > 0
+    dx[ok] /= n[ok]
+    dy[ok] /= n[ok]
+    return dx, dy
+
+
 def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local: PlanTransform,
                workers: int = 1) -> TileViews:
     """Visibility and view quality of the outer window of ``tile`` (module docstring)."""
@@ -172,7 +205,24 @@ def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local
         with np.errstate(invalid="ignore"):
             include = (dist == 0) | (hreg - zlow > dist / math.tan(setup.max_view) - res)
         tris = surface.triangles(region, hreg, include, to_local, setup.wall_min)
-    normals = _normals(h, res).reshape(-1, 3)
+    normals3 = _normals(h, res)
+    normals = normals3.reshape(-1, 3)
+    # colour sample points: cells next to a height discontinuity are sampled a little inside their own
+    # side, so the bilinear sample does not mix in the other side of a building outline
+    S = P
+    if setup.edge_shift > 0:
+        ex, ey = edge_shift(h, setup.discontinuity)
+        moved = (ex != 0) | (ey != 0)
+        if moved.any():
+            delta = setup.edge_shift * res
+            sx, sy = X + delta * ex, Y + delta * ey
+            slx, sly = to_local.xy(sx[moved], sy[moved])
+            # height along the cell's own slope
+            nz = normals3[..., 2][moved]
+            sz = lz[moved] - delta * (normals3[..., 0][moved] * ex[moved] + normals3[..., 1][moved] * ey[moved]) / nz
+            S = P.copy()
+            mi = np.flatnonzero(moved.ravel())
+            S[mi, 0], S[mi, 1], S[mi, 2] = slx, sly, sz
 
     def one(k):
         im = setup.images[k]
@@ -214,10 +264,17 @@ def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local
             vis, ne, uvk, _ = point_visibility(Pk, tol, im.R, im.C, cam, zb, win, scale)
             usable[idx] = vis
             edge[idx] = ne & vis
-            uv[idx] = uvk
         else:
             usable[idx] = True
-            uv[idx] = uvp[inside]
+        uvs = project(S[idx], im.R, im.C, cam)
+        good = uvs[:, 2] > 0
+        uv[idx[good]] = uvs[good, :2]
+        usable[idx[~good]] = False
+        if setup.visibility:
+            # next to an occluder: the nearest pixel (the one that passed the depth test) instead of a
+            # bilinear mix with the occluder's pixels
+            ne_i = np.flatnonzero(edge)
+            uv[ne_i] = np.round(uv[ne_i])
         cos_inc = np.einsum("ij,ij->i", normals, ray)
         usable &= cos_inc > 0.02
         eff = np.where(usable, dist / (cam.fx * np.maximum(cos_inc, 0.02)), np.inf).astype(np.float32)
