@@ -104,7 +104,8 @@ class ColorCorrection:
     lab : bool
         Channels 0-2 are L*a*b*.
     stats : dict
-        ``observations``, ``pairs``, ``rms_before``, ``rms_after`` (channel units), ``images_constrained``.
+        ``observations``, ``pairs``, ``rms_before``, ``rms_after``, ``median_before``,
+        ``median_after`` (absolute pair disagreement, channel units), ``images_constrained``.
     """
 
     gain: np.ndarray
@@ -187,7 +188,7 @@ def estimate_corrections(obs_cell, obs_image, obs_values, n_images: int, prior: 
     ii, jj, ia, ib = ii[keep], jj[keep], ia[keep], ib[keep]
     stats["pairs"] = int(len(ii))
     stats["images_constrained"] = int(len(np.unique(np.concatenate([ia, ib])))) if len(ia) else 0
-    rms_before, rms_after = [], []
+    rms_before, rms_after, mad_before, mad_after = [], [], [], []
     for ch in range(nch):
         xa, xb = val[ii, ch], val[jj, ch]
         both = np.concatenate([xa, xb])
@@ -209,8 +210,12 @@ def estimate_corrections(obs_cell, obs_image, obs_values, n_images: int, prior: 
         rb = ((g[ia] * xa + offset[ia, ch]) - (g[ib] * xb + offset[ib, ch])) ** 2
         rms_before.append(float(np.sqrt(np.mean(ra))))
         rms_after.append(float(np.sqrt(np.mean(rb))))
+        mad_before.append(float(np.median(np.sqrt(ra))))
+        mad_after.append(float(np.median(np.sqrt(rb))))
     stats["rms_before"] = [round(v, 4) for v in rms_before]
     stats["rms_after"] = [round(v, 4) for v in rms_after]
+    stats["median_before"] = [round(v, 4) for v in mad_before]
+    stats["median_after"] = [round(v, 4) for v in mad_after]
     return ColorCorrection(gain, offset, uses_lab(nch), stats)
 
 

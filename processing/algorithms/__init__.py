@@ -10,6 +10,7 @@ from .exportorientation import ExportOrientationAlgorithm
 from .importgcps import ImportGcpsAlgorithm
 from .importorientation import ImportOrientationAlgorithm
 from .orientimages import OrientImagesAlgorithm
+from .trueortho import TrueOrthoAlgorithm
 
 ALGORITHMS: list[type] = [
     EnvironmentAlgorithm,
@@ -17,4 +18,5 @@ ALGORITHMS: list[type] = [
     ExportOrientationAlgorithm,
     ImportGcpsAlgorithm,
     OrientImagesAlgorithm,
+    TrueOrthoAlgorithm,
 ]
