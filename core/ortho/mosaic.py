@@ -169,8 +169,12 @@ def candidate_colours(views: TileViews, store: ImageStore, correction: ColorCorr
 
 
 def mosaic_tile(views: TileViews, store: ImageStore, correction: ColorCorrection | None, res: float,
-                params: MosaicParams) -> TileMosaic:
-    """Labels, blended colours, alpha and occlusion of a tile's outer window."""
+                params: MosaicParams, fixed: np.ndarray | None = None) -> TileMosaic:
+    """Labels, blended colours, alpha and occlusion of a tile's outer window.
+
+    ``fixed``: (rows, cols) global image indices already written by neighbouring
+    tiles (-1 = free), continued here (:func:`~.select.select_labels`).
+    """
     rows, cols = views.heights.shape
     valid = np.isfinite(views.heights)
     bands = store.bands
@@ -185,8 +189,14 @@ def mosaic_tile(views: TileViews, store: ImageStore, correction: ColorCorrection
     cost = data_costs(views.eff_res, usable, views.near_edge, params.edge_penalty)
     colours = candidate_colours(views, store, correction, res)
     lum = luminance01(colours, store.dtype)
+    local_fixed = None
+    if fixed is not None and (fixed >= 0).any():
+        lut = {int(g): k for k, g in enumerate(views.cands)}
+        local_fixed = np.full(fixed.shape, -1, np.int32)
+        for g, k in lut.items():
+            local_fixed[fixed == g] = k
     labels = select_labels(cost, views.heights, lum, res, params.smoothness, params.contrast,
-                           params.discontinuity, sweeps=params.sweeps)
+                           params.discontinuity, sweeps=params.sweeps, fixed=local_fixed)
     clean = usable & ~views.near_edge
     w = feather_weights(labels, clean, params.blend_width)
     col = np.where(np.isfinite(colours), colours, 0.0)

@@ -337,11 +337,13 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
                                                      overview_resampling="nearest", cog=cfg.cog,
                                                      descriptions=["1 = seen by no image"]))
         tri_max = 0
+        done: dict[tuple[int, int], tuple] = {}  # labels of the cores of the previous and current tile row
         for n, tile in enumerate(tiles):
             check(progress)
             views = tile_views(setup, surf, grid, tile, to_local, workers)
             tri_max = max(tri_max, views.triangles)
-            m = mosaic_tile(views, store, correction, res, params)
+            fixed = _fixed_labels(tile, done)
+            m = mosaic_tile(views, store, correction, res, params, fixed)
             sl = tile.inner_slices
             vals = to_dtype(m.values[:, sl[0], sl[1]], dtype)
             alpha = m.alpha[sl]
@@ -349,6 +351,9 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
             a = np.where(alpha, amax, 0).astype(dtype)
             w_out.write(np.concatenate([vals, a[None]], axis=0), tile.core)
             lab = m.label[sl]
+            done[tile.index] = (tile.core, lab.astype(np.int16))
+            for key in [k for k in done if k[0] < tile.index[0] - 1]:
+                del done[key]
             if w_idx is not None:
                 w_idx.write(lab.astype(np.int16), tile.core)
             if w_occ is not None:
@@ -377,6 +382,18 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
     prog.update(1.0, None)
     return TrueOrthoResult(out_path, Path(source_index) if source_index else None,
                            Path(occlusion) if occlusion else None, grid, regions, correction, stats)
+
+
+def _fixed_labels(tile, done: dict) -> np.ndarray:
+    """Labels already written in the tile's outer window by earlier tiles (-1 elsewhere)."""
+    r0, c0, nr, nc = tile.outer
+    out = np.full((nr, nc), -1, np.int64)
+    for (cr0, cc0, cnr, cnc), lab in done.values():
+        a0, a1 = max(r0, cr0), min(r0 + nr, cr0 + cnr)
+        b0, b1 = max(c0, cc0), min(c0 + nc, cc0 + cnc)
+        if a1 > a0 and b1 > b0:
+            out[a0 - r0: a1 - r0, b0 - c0: b1 - c0] = lab[a0 - cr0: a1 - cr0, b0 - cc0: b1 - cc0]
+    return out
 
 
 def _estimate_colour(setup, surf, grid: RasterGrid, to_local, store: ImageStore, cfg: TrueOrthoConfig,

@@ -30,7 +30,9 @@ The energy is minimised approximately (:func:`select_labels`):
    ``max_segment_cells`` (a building's roof plane or a whole roof) is
    initialised with the single image of least total cost among those that see
    at least ``segment_cover`` of its cells, so no seam starts inside a roof;
-   larger segments (open ground) start from the per-cell best label;
+   larger segments (open ground; also a segment cut by the window border that
+   fills a quarter of the window) start from the per-cell best label. Labels
+   written by neighbouring tiles are kept and their segments continue them;
 2. iterated conditional modes (sequential sweeps, each cell takes the label of
    least local energy given its neighbours) until no label changes or
    ``sweeps`` is reached. ICM only lowers the energy; with the segment start it
@@ -88,22 +90,37 @@ def segments(h: np.ndarray, step: float) -> np.ndarray:
 
 
 def initial_labels(cost: np.ndarray, h: np.ndarray, step: float, max_segment_cells: int,
-                   segment_cover: float = 0.9) -> np.ndarray:
-    """Per-cell best label, replaced by one label per small segment (module docstring, step 1)."""
+                   segment_cover: float = 0.9, fixed: np.ndarray | None = None) -> np.ndarray:
+    """Per-cell best label, replaced by one label per small segment (module docstring, step 1).
+
+    ``fixed`` (rows, cols) holds labels decided by neighbouring tiles (-1 = free): a segment
+    with fixed cells takes their most frequent label when that image sees enough of it, and
+    fixed cells keep their label.
+    """
     K, rows, cols = cost.shape
     finite = np.isfinite(cost)
     any_vis = finite.any(axis=0)
     lab = np.where(any_vis, np.argmin(np.where(finite, cost, np.inf), axis=0), NO_LABEL).astype(np.int32)
+    if fixed is not None:
+        fx = np.asarray(fixed)
+        fixed_ok = (fx >= 0) & np.take_along_axis(finite, np.clip(fx, 0, K - 1)[None], axis=0)[0]
     if K < 2:
         return lab
     seg = segments(h, step)
     valid = seg >= 0
     if not valid.any():
         return lab
+    if fixed is None:
+        fixed_ok = np.zeros((rows, cols), bool)
     s = seg[valid]
     nseg = int(s.max()) + 1
     size = np.bincount(s, minlength=nseg)
     small = (size >= 2) & (size <= max_segment_cells)
+    # a segment cut by the window border may be much larger than it looks (open ground): one that
+    # fills a quarter of the window is treated as large
+    border = np.unique(np.concatenate([seg[0], seg[-1], seg[:, 0], seg[:, -1]]))
+    border = border[border >= 0]
+    small[border] &= size[border] <= 0.25 * rows * cols
     if not small.any():
         return lab
     cand = small[s]
@@ -118,6 +135,17 @@ def initial_labels(cost: np.ndarray, h: np.ndarray, step: float, max_segment_cel
         total[k] = np.bincount(sid, weights=np.where(f, c, 0.0), minlength=nseg)
     cover = seen / np.maximum(size[None, :], 1)
     score = np.where(cover >= segment_cover, total / np.maximum(seen, 1) + (1.0 - cover) * 10.0, np.inf)
+    if fixed is not None and fixed_ok.any():
+        # segments continuing a neighbouring tile keep that tile's image
+        fs = seg[fixed_ok]
+        fl = np.asarray(fixed)[fixed_ok].astype(np.int64)
+        votes = np.zeros((K, nseg))
+        np.add.at(votes, (fl, fs), 1.0)
+        has_vote = votes.sum(axis=0) > 0
+        pref = np.argmax(votes, axis=0)
+        keep = has_vote & np.isfinite(score[pref, np.arange(nseg)])
+        score[:, keep] = np.inf
+        score[pref[keep], np.flatnonzero(keep)] = 0.0
     best = np.argmin(score, axis=0)
     has = np.isfinite(score[best, np.arange(nseg)]) & small
     seg_label = np.where(has, best, -1)
@@ -127,6 +155,8 @@ def initial_labels(cost: np.ndarray, h: np.ndarray, step: float, max_segment_cel
     kk = np.clip(full, 0, K - 1)
     ok = take & np.take_along_axis(finite, kk[None], axis=0)[0]
     lab[ok] = full[ok]
+    if fixed is not None:
+        lab[fixed_ok] = np.asarray(fixed)[fixed_ok]
     return lab
 
 
@@ -146,7 +176,7 @@ def _pair_cost(a, b, r0, c0, r1, c1, w, lum, contrast):
 
 
 @njit
-def _icm(labels, cost, lum, wh, wv, smooth, contrast, sweeps):
+def _icm(labels, frozen, cost, lum, wh, wv, smooth, contrast, sweeps):
     K = cost.shape[0]
     rows = labels.shape[0]
     cols = labels.shape[1]
@@ -156,7 +186,7 @@ def _icm(labels, cost, lum, wh, wv, smooth, contrast, sweeps):
         for r in range(rows):
             for c in range(cols):
                 cur = labels[r, c]
-                if cur < 0:
+                if cur < 0 or frozen[r, c]:
                     continue
                 best = cur
                 best_e = np.inf
@@ -195,7 +225,8 @@ def _icm(labels, cost, lum, wh, wv, smooth, contrast, sweeps):
 
 def select_labels(cost: np.ndarray, h: np.ndarray, lum: np.ndarray | None, res: float,
                   smoothness: float = 1.0, contrast: float = 4.0, discontinuity: float = 0.5,
-                  max_segment_cells: int | None = None, sweeps: int = 8) -> np.ndarray:
+                  max_segment_cells: int | None = None, sweeps: int = 8,
+                  fixed: np.ndarray | None = None) -> np.ndarray:
     """Image label per cell (index into the candidate axis of ``cost``; -1 where none sees the cell).
 
     Parameters
@@ -219,17 +250,23 @@ def select_labels(cost: np.ndarray, h: np.ndarray, lum: np.ndarray | None, res: 
         Largest segment labelled as a whole (default: a 60 m x 60 m roof).
     sweeps : int
         ICM sweeps.
+    fixed : (rows, cols) int, optional
+        Labels already decided by neighbouring tiles (-1 = free); they are kept,
+        and segments and seams continue them, so tiles join without new seams.
     """
     K = cost.shape[0]
     h0 = max(float(discontinuity), 2.0 * float(res))
     if max_segment_cells is None:
         max_segment_cells = int(math.ceil((60.0 / res) ** 2))
-    labels = initial_labels(cost, h, h0, max_segment_cells)
+    labels = initial_labels(cost, h, h0, max_segment_cells, fixed=fixed)
     if K < 2 or smoothness <= 0 or sweeps <= 0:
         return labels
+    frozen = np.zeros(labels.shape, np.bool_)
+    if fixed is not None:
+        frozen = (np.asarray(fixed) >= 0) & (labels == np.asarray(fixed))
     wh, wv = edge_weights(h, h0)
     if lum is None:
         lum = np.full(cost.shape, np.nan, np.float32)
-    _icm(labels, np.ascontiguousarray(cost, dtype=np.float32), np.ascontiguousarray(lum, dtype=np.float32),
+    _icm(labels, frozen, np.ascontiguousarray(cost, dtype=np.float32), np.ascontiguousarray(lum, dtype=np.float32),
          wh, wv, float(smoothness), float(contrast), int(sweeps))
     return labels
