@@ -35,9 +35,9 @@ import numpy as np
 
 from ..errors import InputError
 
-_M = np.array([[0.4124564, 0.3575761, 0.1804375],
-               [0.2126729, 0.7151522, 0.0721750],
-               [0.0193339, 0.1191920, 0.9503041]])
+_M = np.array(
+    [[0.4124564, 0.3575761, 0.1804375], [0.2126729, 0.7151522, 0.0721750], [0.0193339, 0.1191920, 0.9503041]]
+)
 _M_INV = np.linalg.inv(_M)
 _WHITE = np.array([0.95047, 1.0, 1.08883])
 _D = 6.0 / 29.0
@@ -49,8 +49,9 @@ def rgb_to_lab(rgb) -> np.ndarray:
     lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
     xyz = lin @ _M.T / _WHITE
     f = np.where(xyz > _D**3, np.cbrt(xyz), xyz / (3 * _D**2) + 4.0 / 29.0)
-    return np.stack([116.0 * f[..., 1] - 16.0, 500.0 * (f[..., 0] - f[..., 1]), 200.0 * (f[..., 1] - f[..., 2])],
-                    axis=-1)
+    return np.stack(
+        [116.0 * f[..., 1] - 16.0, 500.0 * (f[..., 0] - f[..., 1]), 200.0 * (f[..., 1] - f[..., 2])], axis=-1
+    )
 
 
 def lab_to_rgb(lab) -> np.ndarray:
@@ -136,15 +137,31 @@ class ColorCorrection:
     def as_dict(self, names: list[str] | None = None) -> dict:
         rows = []
         for i in range(len(self.gain)):
-            rows.append({"image": names[i] if names else i, "gain": [round(float(v), 5) for v in self.gain[i]],
-                         "offset": [round(float(v), 5) for v in self.offset[i]]})
-        return {"model": "L*a*b* gain/offset" if self.lab else "per-band gain/offset", "images": rows,
-                **self.stats}
+            rows.append(
+                {
+                    "image": names[i] if names else i,
+                    "gain": [round(float(v), 5) for v in self.gain[i]],
+                    "offset": [round(float(v), 5) for v in self.offset[i]],
+                }
+            )
+        return {
+            "model": "L*a*b* gain/offset" if self.lab else "per-band gain/offset",
+            "images": rows,
+            **self.stats,
+        }
 
 
-def estimate_corrections(obs_cell, obs_image, obs_values, n_images: int, prior: float = 1e-3,
-                         huber: float = 1.5, iterations: int = 4, max_pairs: int = 400_000,
-                         seed: int = 0) -> ColorCorrection:
+def estimate_corrections(
+    obs_cell,
+    obs_image,
+    obs_values,
+    n_images: int,
+    prior: float = 1e-3,
+    huber: float = 1.5,
+    iterations: int = 4,
+    max_pairs: int = 400_000,
+    seed: int = 0,
+) -> ColorCorrection:
     """Least-squares gains and offsets from multiply observed cells.
 
     Parameters

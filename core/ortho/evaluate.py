@@ -28,6 +28,7 @@ from .color import rgb_to_lab
 
 def delta_e(rgb_a: np.ndarray, rgb_b: np.ndarray) -> np.ndarray:
     """dE*ab (CIE76) between sRGB images ``(rows, cols, 3)`` (uint8 or floats in [0, 1])."""
+
     def lab(x):
         x = np.asarray(x)
         f = x.astype(np.float64) / 255.0 if x.dtype == np.uint8 else x.astype(np.float64)
@@ -71,8 +72,9 @@ def ghosting(result_rgb, truth_rgb, valid, buildings, band_cells: float, thresho
     return {"share": float(ghost.sum() / n) if n else 0.0, "cells": n, "ghost_cells": int(ghost.sum())}
 
 
-def phase_shift(result_lum, truth_lum, valid, tile: int = 64, min_valid: float = 0.98,
-                min_contrast: float = 0.02) -> dict:
+def phase_shift(
+    result_lum, truth_lum, valid, tile: int = 64, min_valid: float = 0.98, min_contrast: float = 0.02
+) -> dict:
     """Median shift (cells) between two luminance images by phase correlation on tiles.
 
     Tiles with less than ``min_valid`` data or less than ``min_contrast``

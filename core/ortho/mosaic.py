@@ -31,8 +31,9 @@ from .views import TileViews
 class ImageStore:
     """Decoded images by (index, level) with an LRU cache of at most ``max_bytes``."""
 
-    def __init__(self, paths: list[str], sizes: list[tuple[int, int]], bands: int, dtype,
-                 max_bytes: int = 1 << 30) -> None:
+    def __init__(
+        self, paths: list[str], sizes: list[tuple[int, int]], bands: int, dtype, max_bytes: int = 1 << 30
+    ) -> None:
         self.paths = paths
         self.sizes = sizes
         self.bands = int(bands)
@@ -52,12 +53,16 @@ class ImageStore:
             self.reads += 1
             w, h = self.sizes[i]
             if img.shape[:2] != (h, w):
-                raise FormatError(self.paths[i], f"image is {img.shape[1]} x {img.shape[0]} pixels but its camera "
-                                  f"says {w} x {h}")
+                raise FormatError(
+                    self.paths[i],
+                    f"image is {img.shape[1]} x {img.shape[0]} pixels but its camera says {w} x {h}",
+                )
             nb = 1 if img.ndim == 2 else img.shape[2]
             if nb != self.bands or img.dtype != self.dtype:
-                raise FormatError(self.paths[i], f"image has {nb} band(s) of {img.dtype}, the block "
-                                  f"{self.bands} band(s) of {self.dtype}")
+                raise FormatError(
+                    self.paths[i],
+                    f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
+                )
         else:
             import cv2
 
@@ -65,8 +70,13 @@ class ImageStore:
             h, w = src.shape[:2]
             nw, nh = max(1, (w + 1) // 2), max(1, (h + 1) // 2)
             if src.ndim == 3 and src.shape[2] > 4:
-                img = np.stack([cv2.resize(src[:, :, c], (nw, nh), interpolation=cv2.INTER_AREA)
-                                for c in range(src.shape[2])], -1)
+                img = np.stack(
+                    [
+                        cv2.resize(src[:, :, c], (nw, nh), interpolation=cv2.INTER_AREA)
+                        for c in range(src.shape[2])
+                    ],
+                    -1,
+                )
             else:
                 img = cv2.resize(src, (nw, nh), interpolation=cv2.INTER_AREA)
         img = np.ascontiguousarray(img)
@@ -101,7 +111,11 @@ def sample(img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, in
     mx[bad] = -10.0
     my[bad] = -10.0
     src = img if img.dtype in (np.uint8, np.uint16, np.int16, np.float32) else img.astype(np.float32)
-    chans = [src] if src.ndim == 2 else ([src] if src.shape[2] <= 4 else [src[:, :, c] for c in range(src.shape[2])])
+    chans = (
+        [src]
+        if src.ndim == 2
+        else ([src] if src.shape[2] <= 4 else [src[:, :, c] for c in range(src.shape[2])])
+    )
     outs = []
     for ch in chans:
         o = cv2.remap(ch, mx, my, interpolation=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
@@ -148,9 +162,17 @@ class TileMosaic:
     occlusion: np.ndarray
 
 
-def candidate_colours(views: TileViews, store: ImageStore, correction: ColorCorrection | None, res: float,
-                      needed: np.ndarray | None = None) -> np.ndarray:
-    """Corrected colours ``(K, rows, cols, bands)`` float32 of every candidate where usable (NaN elsewhere)."""
+def candidate_colours(
+    views: TileViews,
+    store: ImageStore,
+    correction: ColorCorrection | None,
+    res: float,
+    needed: np.ndarray | None = None,
+) -> np.ndarray:
+    """Corrected colours ``(K, rows, cols, bands)`` float32 of every candidate where usable.
+
+    NaN where the candidate is not usable (or not ``needed``).
+    """
     K, rows, cols = views.usable.shape
     out = np.full((K, rows, cols, store.bands), np.nan, np.float32)
     for k in range(K):
@@ -168,8 +190,14 @@ def candidate_colours(views: TileViews, store: ImageStore, correction: ColorCorr
     return out
 
 
-def mosaic_tile(views: TileViews, store: ImageStore, correction: ColorCorrection | None, res: float,
-                params: MosaicParams, fixed: np.ndarray | None = None) -> TileMosaic:
+def mosaic_tile(
+    views: TileViews,
+    store: ImageStore,
+    correction: ColorCorrection | None,
+    res: float,
+    params: MosaicParams,
+    fixed: np.ndarray | None = None,
+) -> TileMosaic:
     """Labels, blended colours, alpha and occlusion of a tile's outer window.
 
     ``fixed``: (rows, cols) global image indices already written by neighbouring
@@ -181,8 +209,12 @@ def mosaic_tile(views: TileViews, store: ImageStore, correction: ColorCorrection
     K = len(views.cands)
     occl = np.where(valid, 1, 255).astype(np.uint8)
     if K == 0:
-        return TileMosaic(np.zeros((bands, rows, cols), np.float32), np.zeros((rows, cols), bool),
-                          np.full((rows, cols), -1, np.int64), occl)
+        return TileMosaic(
+            np.zeros((bands, rows, cols), np.float32),
+            np.zeros((rows, cols), bool),
+            np.full((rows, cols), -1, np.int64),
+            occl,
+        )
     usable = views.usable & valid[None]
     seen = usable.any(axis=0)
     occl[valid & seen] = 0
@@ -195,8 +227,17 @@ def mosaic_tile(views: TileViews, store: ImageStore, correction: ColorCorrection
         local_fixed = np.full(fixed.shape, -1, np.int32)
         for g, k in lut.items():
             local_fixed[fixed == g] = k
-    labels = select_labels(cost, views.heights, lum, res, params.smoothness, params.contrast,
-                           params.discontinuity, sweeps=params.sweeps, fixed=local_fixed)
+    labels = select_labels(
+        cost,
+        views.heights,
+        lum,
+        res,
+        params.smoothness,
+        params.contrast,
+        params.discontinuity,
+        sweeps=params.sweeps,
+        fixed=local_fixed,
+    )
     clean = usable & ~views.near_edge
     w = feather_weights(labels, clean, params.blend_width)
     col = np.where(np.isfinite(colours), colours, 0.0)

@@ -125,8 +125,11 @@ class TrueOrthoConfig:
         def bad(name, why):
             raise InputError(f"{name}: {why} (got {getattr(self, name)!r})")
 
-        if self.resolution is not None and not (isinstance(self.resolution, int | float)
-                                                and math.isfinite(self.resolution) and self.resolution > 0):
+        if self.resolution is not None and not (
+            isinstance(self.resolution, int | float)
+            and math.isfinite(self.resolution)
+            and self.resolution > 0
+        ):
             bad("resolution", "expected a positive cell size")
         if not 0 < float(self.max_view_angle) < 89:
             bad("max_view_angle", "expected degrees in (0, 89)")
@@ -184,16 +187,26 @@ def _default_resolution(surface, orientation: Orientation) -> float:
         return float(surface.res)
     lo, hi = surface.height_range()
     z = 0.5 * (lo + hi) - orientation.offset[2]
-    g = [abs(im.C[2] - z) / orientation.camera_of(im).fx for im in orientation.images
-         if im.R[2, 2] < -math.cos(math.radians(20))]
+    g = [
+        abs(im.C[2] - z) / orientation.camera_of(im).fx
+        for im in orientation.images
+        if im.R[2, 2] < -math.cos(math.radians(20))
+    ]
     if not g:
         g = [abs(im.C[2] - z) / orientation.camera_of(im).fx for im in orientation.images]
     return float(np.median(g))
 
 
-def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
-               config: TrueOrthoConfig | None = None, progress: Progress | None = None,
-               image_root: str | os.PathLike | None = None) -> TrueOrthoResult:
+def true_ortho(
+    orientation,
+    surface,
+    output,
+    source_index=None,
+    occlusion=None,
+    config: TrueOrthoConfig | None = None,
+    progress: Progress | None = None,
+    image_root: str | os.PathLike | None = None,
+) -> TrueOrthoResult:
     """Compute a true orthophoto.
 
     Parameters
@@ -234,8 +247,10 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
     surf = open_surface(surface)
     o_crs = o.crs
     if o_crs is None and (surf.crs is not None or cfg.crs is not None):
-        raise CRSError("ORIENTATION: the orientation has no CRS; a true orthophoto of a georeferenced "
-                       "surface needs a georeferenced orientation")
+        raise CRSError(
+            "ORIENTATION: the orientation has no CRS; a true orthophoto of a georeferenced "
+            "surface needs a georeferenced orientation"
+        )
     if o_crs is not None:
         from ..geometry.frame import parse_crs, require_metric
 
@@ -255,23 +270,45 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
     tol = 0.5 * res + 1e-6 * max(abs(gx0), abs(gy1), 1.0)
     if surf.crs is not None and out_crs is not None and not same_crs(surf.crs, out_crs):
         tol += 2.0 * (surf.res or res)
-    if gx0 < s_bounds[0] - tol or gy0 < s_bounds[1] - tol or gx1 > s_bounds[2] + tol or gy1 > s_bounds[3] + tol:
+    if (
+        gx0 < s_bounds[0] - tol
+        or gy0 < s_bounds[1] - tol
+        or gx1 > s_bounds[2] + tol
+        or gy1 > s_bounds[3] + tol
+    ):
         raise InputError(
             f"SURFACE {surf.path}: covers {tuple(round(v, 3) for v in s_bounds)} but EXTENT is "
             f"{tuple(round(v, 3) for v in grid.extent)} (in {out_crs}); give a smaller extent or a "
             "surface covering it"
         )
     # transformation path for the whole extent (raises CRSError)
-    to_local.xy(np.array([gx0, gx1, gx0, gx1, 0.5 * (gx0 + gx1)]), np.array([gy0, gy0, gy1, gy1, 0.5 * (gy0 + gy1)]))
+    to_local.xy(
+        np.array([gx0, gx1, gx0, gx1, 0.5 * (gx0 + gx1)]), np.array([gy0, gy0, gy1, gy1, 0.5 * (gy0 + gy1)])
+    )
     wall_min = cfg.wall_min if cfg.wall_min is not None else 0.25 * res
-    setup = prepare_views(o, surf, to_local, res, cfg.max_view_angle, cfg.visibility, cfg.depth_tolerance,
-                          cfg.zbuffer_oversample, wall_min, cfg.discontinuity, cfg.edge_shift)
+    setup = prepare_views(
+        o,
+        surf,
+        to_local,
+        res,
+        cfg.max_view_angle,
+        cfg.visibility,
+        cfg.depth_tolerance,
+        cfg.zbuffer_oversample,
+        wall_min,
+        cfg.discontinuity,
+        cfg.edge_shift,
+    )
     # ---- images that can contribute: on disk, one band count and dtype
     ex_x, ex_y = to_local.xy(np.array([gx0, gx1, gx0, gx1]), np.array([gy0, gy0, gy1, gy1]))
     b = setup.boxes
     with np.errstate(invalid="ignore"):
-        relevant = np.flatnonzero((b[:, 0] <= ex_x.max()) & (b[:, 2] >= ex_x.min()) & (b[:, 1] <= ex_y.max())
-                                  & (b[:, 3] >= ex_y.min()))
+        relevant = np.flatnonzero(
+            (b[:, 0] <= ex_x.max())
+            & (b[:, 2] >= ex_x.min())
+            & (b[:, 1] <= ex_y.max())
+            & (b[:, 3] >= ex_y.min())
+        )
     if not len(relevant):
         raise InputError("EXTENT: no image of the orientation sees the extent")
     paths = [str(o.resolve_image_path(im, image_root)) for im in o.images]
@@ -284,29 +321,45 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
     for i in relevant:
         inf = infos[i]
         if inf.bands != first.bands or inf.dtype != first.dtype:
-            raise InputError(f"{inf.path}: {inf.bands} band(s) of {inf.dtype}, but {first.path} has "
-                             f"{first.bands} band(s) of {first.dtype}; all images of a mosaic must match")
+            raise InputError(
+                f"{inf.path}: {inf.bands} band(s) of {inf.dtype}, but {first.path} has "
+                f"{first.bands} band(s) of {first.dtype}; all images of a mosaic must match"
+            )
         cam = setup.cameras[i]
         if (inf.width, inf.height) != (cam.width, cam.height):
-            raise InputError(f"{inf.path}: image is {inf.width} x {inf.height} pixels but its camera "
-                             f"{cam.id!r} is {cam.width} x {cam.height}")
+            raise InputError(
+                f"{inf.path}: image is {inf.width} x {inf.height} pixels but its camera "
+                f"{cam.id!r} is {cam.width} x {cam.height}"
+            )
     # only relevant images are candidates
     setup.boxes[np.setdiff1d(np.arange(len(o.images)), relevant)] = np.nan
     bands, dtype = first.bands, np.dtype(first.dtype)
     sizes = [(c.width, c.height) for c in setup.cameras]
     store = ImageStore(paths, sizes, bands, dtype, cfg.image_cache_mb << 20)
-    params = MosaicParams(cfg.edge_penalty, cfg.smoothness, cfg.contrast, cfg.discontinuity, cfg.blend_width,
-                          cfg.sweeps)
+    params = MosaicParams(
+        cfg.edge_penalty, cfg.smoothness, cfg.contrast, cfg.discontinuity, cfg.blend_width, cfg.sweeps
+    )
     workers = max(1, int(cfg.workers))
     steps[0].update(1.0, f"true ortho: {grid.rows} x {grid.cols} cells of {res:g}, {len(relevant)} images")
-    stats: dict = {"rows": grid.rows, "cols": grid.cols, "resolution": res, "crs": out_crs,
-                   "images_relevant": int(len(relevant)), "bands": bands, "dtype": dtype.name,
-                   "visibility": cfg.visibility, "margin_cells": setup.margin_cells, "reprojected": not to_local.identity}
+    stats: dict = {
+        "rows": grid.rows,
+        "cols": grid.cols,
+        "resolution": res,
+        "crs": out_crs,
+        "images_relevant": int(len(relevant)),
+        "bands": bands,
+        "dtype": dtype.name,
+        "visibility": cfg.visibility,
+        "margin_cells": setup.margin_cells,
+        "reprojected": not to_local.identity,
+    }
     # ---- colour correction
     correction = None
     t0 = time.perf_counter()
     if cfg.color_correction and len(relevant) > 1:
-        correction = _estimate_colour(setup, surf, grid, to_local, store, cfg, steps[1], workers, len(o.images))
+        correction = _estimate_colour(
+            setup, surf, grid, to_local, store, cfg, steps[1], workers, len(o.images)
+        )
         stats["color_correction"] = correction.as_dict([im.name for im in o.images])
     stats["seconds_color"] = round(time.perf_counter() - t0, 3)
     # ---- mosaic
@@ -319,23 +372,54 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
     n_seen = n_valid = n_occl = 0
     out_path = Path(os.fspath(output))
     names = [f"band {k + 1}" for k in range(bands)] + ["alpha"]
-    amax = (np.iinfo(dtype).max if dtype.kind in "ui" else 1.0)
+    amax = np.iinfo(dtype).max if dtype.kind in "ui" else 1.0
     with contextlib.ExitStack() as stack:
         from ..rasterio_io import RasterWriter
 
-        w_out = stack.enter_context(RasterWriter(out_path, grid, bands=bands + 1, dtype=dtype, nodata=None,
-                                                 descriptions=names, alpha=True, overviews=True, cog=cfg.cog,
-                                                 photometric="RGB" if bands == 3 else "MINISBLACK"))
+        w_out = stack.enter_context(
+            RasterWriter(
+                out_path,
+                grid,
+                bands=bands + 1,
+                dtype=dtype,
+                nodata=None,
+                descriptions=names,
+                alpha=True,
+                overviews=True,
+                cog=cfg.cog,
+                photometric="RGB" if bands == 3 else "MINISBLACK",
+            )
+        )
         w_idx = None
         if source_index is not None:
-            w_idx = stack.enter_context(RasterWriter(source_index, grid, 1, "int16", nodata=-1, overviews=True,
-                                                     overview_resampling="nearest", cog=cfg.cog,
-                                                     descriptions=["source image index"]))
+            w_idx = stack.enter_context(
+                RasterWriter(
+                    source_index,
+                    grid,
+                    1,
+                    "int16",
+                    nodata=-1,
+                    overviews=True,
+                    overview_resampling="nearest",
+                    cog=cfg.cog,
+                    descriptions=["source image index"],
+                )
+            )
         w_occ = None
         if occlusion is not None:
-            w_occ = stack.enter_context(RasterWriter(occlusion, grid, 1, "uint8", nodata=255, overviews=True,
-                                                     overview_resampling="nearest", cog=cfg.cog,
-                                                     descriptions=["1 = seen by no image"]))
+            w_occ = stack.enter_context(
+                RasterWriter(
+                    occlusion,
+                    grid,
+                    1,
+                    "uint8",
+                    nodata=255,
+                    overviews=True,
+                    overview_resampling="nearest",
+                    cog=cfg.cog,
+                    descriptions=["1 = seen by no image"],
+                )
+            )
         tri_max = 0
         done: dict[tuple[int, int], tuple] = {}  # labels of the cores of the previous and current tile row
         for n, tile in enumerate(tiles):
@@ -371,17 +455,31 @@ def true_ortho(orientation, surface, output, source_index=None, occlusion=None,
         steps[3].update(0.0, "writing overviews")
     stats["seconds_mosaic"] = round(time.perf_counter() - t0, 3)
     regions = [SeamRegion(k, o.images[k].name, int(counts[k]), g) for k, g in dissolve(parts).items()]
-    stats.update({
-        "tiles": len(tiles), "cells": grid.rows * grid.cols, "cells_with_surface": n_valid,
-        "cells_textured": n_seen, "cells_occluded": n_occl,
-        "coverage": round(n_seen / n_valid, 6) if n_valid else 0.0,
-        "images_used": int(np.count_nonzero(counts)), "image_reads": store.reads,
-        "max_triangles_per_tile": int(tri_max), "seconds_total": round(time.perf_counter() - t_start, 3),
-    })
+    stats.update(
+        {
+            "tiles": len(tiles),
+            "cells": grid.rows * grid.cols,
+            "cells_with_surface": n_valid,
+            "cells_textured": n_seen,
+            "cells_occluded": n_occl,
+            "coverage": round(n_seen / n_valid, 6) if n_valid else 0.0,
+            "images_used": int(np.count_nonzero(counts)),
+            "image_reads": store.reads,
+            "max_triangles_per_tile": int(tri_max),
+            "seconds_total": round(time.perf_counter() - t_start, 3),
+        }
+    )
     steps[3].update(1.0, "true orthophoto written")
     prog.update(1.0, None)
-    return TrueOrthoResult(out_path, Path(source_index) if source_index else None,
-                           Path(occlusion) if occlusion else None, grid, regions, correction, stats)
+    return TrueOrthoResult(
+        out_path,
+        Path(source_index) if source_index else None,
+        Path(occlusion) if occlusion else None,
+        grid,
+        regions,
+        correction,
+        stats,
+    )
 
 
 def _fixed_labels(tile, done: dict) -> np.ndarray:
@@ -392,12 +490,21 @@ def _fixed_labels(tile, done: dict) -> np.ndarray:
         a0, a1 = max(r0, cr0), min(r0 + nr, cr0 + cnr)
         b0, b1 = max(c0, cc0), min(c0 + nc, cc0 + cnc)
         if a1 > a0 and b1 > b0:
-            out[a0 - r0: a1 - r0, b0 - c0: b1 - c0] = lab[a0 - cr0: a1 - cr0, b0 - cc0: b1 - cc0]
+            out[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0] = lab[a0 - cr0 : a1 - cr0, b0 - cc0 : b1 - cc0]
     return out
 
 
-def _estimate_colour(setup, surf, grid: RasterGrid, to_local, store: ImageStore, cfg: TrueOrthoConfig,
-                     progress, workers: int, n_images: int) -> ColorCorrection:
+def _estimate_colour(
+    setup,
+    surf,
+    grid: RasterGrid,
+    to_local,
+    store: ImageStore,
+    cfg: TrueOrthoConfig,
+    progress,
+    workers: int,
+    n_images: int,
+) -> ColorCorrection:
     """Corrections from a decimated copy of the output grid (cells seen cleanly by >= 2 images)."""
     f = max(1, int(math.ceil(math.sqrt(grid.rows * grid.cols / max(cfg.color_cells, 1000)))))
     g = grid.scaled(f)

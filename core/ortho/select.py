@@ -89,8 +89,14 @@ def segments(h: np.ndarray, step: float) -> np.ndarray:
     return lab
 
 
-def initial_labels(cost: np.ndarray, h: np.ndarray, step: float, max_segment_cells: int,
-                   segment_cover: float = 0.9, fixed: np.ndarray | None = None) -> np.ndarray:
+def initial_labels(
+    cost: np.ndarray,
+    h: np.ndarray,
+    step: float,
+    max_segment_cells: int,
+    segment_cover: float = 0.9,
+    fixed: np.ndarray | None = None,
+) -> np.ndarray:
     """Per-cell best label, replaced by one label per small segment (module docstring, step 1).
 
     ``fixed`` (rows, cols) holds labels decided by neighbouring tiles (-1 = free): a segment
@@ -223,10 +229,18 @@ def _icm(labels, frozen, cost, lum, wh, wv, smooth, contrast, sweeps):
     return total_changes
 
 
-def select_labels(cost: np.ndarray, h: np.ndarray, lum: np.ndarray | None, res: float,
-                  smoothness: float = 1.0, contrast: float = 4.0, discontinuity: float = 0.5,
-                  max_segment_cells: int | None = None, sweeps: int = 8,
-                  fixed: np.ndarray | None = None) -> np.ndarray:
+def select_labels(
+    cost: np.ndarray,
+    h: np.ndarray,
+    lum: np.ndarray | None,
+    res: float,
+    smoothness: float = 1.0,
+    contrast: float = 4.0,
+    discontinuity: float = 0.5,
+    max_segment_cells: int | None = None,
+    sweeps: int = 8,
+    fixed: np.ndarray | None = None,
+) -> np.ndarray:
     """Image label per cell (index into the candidate axis of ``cost``; -1 where none sees the cell).
 
     Parameters
@@ -267,6 +281,15 @@ def select_labels(cost: np.ndarray, h: np.ndarray, lum: np.ndarray | None, res: 
     wh, wv = edge_weights(h, h0)
     if lum is None:
         lum = np.full(cost.shape, np.nan, np.float32)
-    _icm(labels, frozen, np.ascontiguousarray(cost, dtype=np.float32), np.ascontiguousarray(lum, dtype=np.float32),
-         wh, wv, float(smoothness), float(contrast), int(sweeps))
+    _icm(
+        labels,
+        frozen,
+        np.ascontiguousarray(cost, dtype=np.float32),
+        np.ascontiguousarray(lum, dtype=np.float32),
+        wh,
+        wv,
+        float(smoothness),
+        float(contrast),
+        int(sweeps),
+    )
     return labels

@@ -60,7 +60,9 @@ class PlanTransform:
             try:
                 self._tr = Transformer.from_crs(parse_crs(src_crs), parse_crs(dst_crs), always_xy=True)
             except ProjError as exc:
-                raise CRSError(f"CRS: no transformation from {_short(src_crs)} to {_short(dst_crs)} ({exc})") from None
+                raise CRSError(
+                    f"CRS: no transformation from {_short(src_crs)} to {_short(dst_crs)} ({exc})"
+                ) from None
 
     @property
     def identity(self) -> bool:
@@ -77,7 +79,8 @@ class PlanTransform:
                 xx, yy = self._tr.transform(x, y, errcheck=True)
             except ProjError as exc:
                 raise CRSError(
-                    f"CRS: cannot transform points from {_short(self.src_crs)} to {_short(self.dst_crs)} ({exc})"
+                    f"CRS: cannot transform points from {_short(self.src_crs)} to "
+                    f"{_short(self.dst_crs)} ({exc})"
                 ) from None
             x, y = np.asarray(xx, dtype=np.float64), np.asarray(yy, dtype=np.float64)
             if not (np.all(np.isfinite(x)) and np.all(np.isfinite(y))):
@@ -119,9 +122,12 @@ def transform_bounds(bounds, src_crs, dst_crs, densify: int = 21):
 
     try:
         tr = Transformer.from_crs(parse_crs(src_crs), parse_crs(dst_crs), always_xy=True)
-        out = tr.transform_bounds(*bounds, densify_pts=densify, errcheck=True)
+        x0, y0, x1, y1 = (float(v) for v in bounds)
+        out = tr.transform_bounds(x0, y0, x1, y1, densify_pts=densify, errcheck=True)
     except ProjError as exc:
-        raise CRSError(f"CRS: no transformation from {_short(src_crs)} to {_short(dst_crs)} ({exc})") from None
+        raise CRSError(
+            f"CRS: no transformation from {_short(src_crs)} to {_short(dst_crs)} ({exc})"
+        ) from None
     if not all(math.isfinite(v) for v in out):
         raise CRSError(f"CRS: no transformation from {_short(src_crs)} to {_short(dst_crs)} for {bounds}")
     return tuple(float(v) for v in out)
@@ -179,8 +185,9 @@ class DsmSurface:
             with rasterio.open(self.path) as ds:
                 step = max(1, 4_000_000 // max(ds.width, 1))
                 for r0 in range(0, ds.height, step):
-                    a = ds.read(self.band, window=Window(0, r0, ds.width, min(step, ds.height - r0)),
-                                masked=True).astype(np.float64)
+                    a = ds.read(
+                        self.band, window=Window(0, r0, ds.width, min(step, ds.height - r0)), masked=True
+                    ).astype(np.float64)
                     v = a.compressed() if np.ma.isMaskedArray(a) else np.ravel(a)
                     v = v[np.isfinite(v)]
                     if len(v):
@@ -199,16 +206,25 @@ class DsmSurface:
         dst = np.full(grid.shape, np.nan, np.float64)
         with rasterio.open(self.path) as ds:
             try:
-                reproject(source=rasterio.band(ds, self.band), destination=dst, src_nodata=ds.nodata,
-                          dst_transform=grid.transform, dst_crs=_crs_obj(grid.crs or self.crs),
-                          dst_nodata=np.nan, resampling=Resampling.nearest)
+                reproject(
+                    source=rasterio.band(ds, self.band),
+                    destination=dst,
+                    src_nodata=ds.nodata,
+                    dst_transform=grid.transform,
+                    dst_crs=_crs_obj(grid.crs or self.crs),
+                    dst_nodata=np.nan,
+                    resampling=Resampling.nearest,
+                )
             except Exception as exc:
-                raise CRSError(f"{self.name}: cannot resample {self.path} onto the output grid ({exc})") from None
+                raise CRSError(
+                    f"{self.name}: cannot resample {self.path} onto the output grid ({exc})"
+                ) from None
         dst[~np.isfinite(dst)] = np.nan
         return dst
 
-    def triangles(self, grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform,
-                  wall_min: float) -> Triangles:
+    def triangles(
+        self, grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform, wall_min: float
+    ) -> Triangles:
         return grid_triangles(grid, heights, include, to_local, wall_min)
 
 
@@ -247,27 +263,38 @@ class ArraySurface(DsmSurface):
                 rs0, cs0 = max(r0, 0), max(c0, 0)
                 rs1, cs1 = min(r0 + grid.rows, self.grid.rows), min(c0 + grid.cols, self.grid.cols)
                 if rs1 > rs0 and cs1 > cs0:
-                    out[rs0 - r0: rs1 - r0, cs0 - c0: cs1 - c0] = self.h[rs0:rs1, cs0:cs1]
+                    out[rs0 - r0 : rs1 - r0, cs0 - c0 : cs1 - c0] = self.h[rs0:rs1, cs0:cs1]
                 return out
         from rasterio.enums import Resampling
         from rasterio.warp import reproject
 
         dst = np.full(grid.shape, np.nan, np.float64)
         try:
-            reproject(source=self.h, destination=dst, src_transform=self.grid.transform,
-                      src_crs=_crs_obj(self.crs), src_nodata=np.nan, dst_transform=grid.transform,
-                      dst_crs=_crs_obj(grid.crs or self.crs), dst_nodata=np.nan, resampling=Resampling.nearest)
+            reproject(
+                source=self.h,
+                destination=dst,
+                src_transform=self.grid.transform,
+                src_crs=_crs_obj(self.crs),
+                src_nodata=np.nan,
+                dst_transform=grid.transform,
+                dst_crs=_crs_obj(grid.crs or self.crs),
+                dst_nodata=np.nan,
+                resampling=Resampling.nearest,
+            )
         except Exception as exc:
             raise CRSError(f"{self.name}: cannot resample the heights onto the output grid ({exc})") from None
         return dst
 
 
-def grid_triangles(grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform,
-                   wall_min: float) -> Triangles:
+def grid_triangles(
+    grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform, wall_min: float
+) -> Triangles:
     """Tops and walls of heights on an output-grid window, in the local frame."""
     if to_local.identity:
         o = to_local.offset
-        return dsm_triangles(heights - o[2], grid.x_min - o[0], grid.y_max - o[1], grid.res, include, wall_min)
+        return dsm_triangles(
+            heights - o[2], grid.x_min - o[0], grid.y_max - o[1], grid.res, include, wall_min
+        )
     tris = dsm_triangles(heights, grid.x_min, grid.y_max, grid.res, include, wall_min)
     used = np.unique(tris.faces)
     v = tris.vertices
@@ -364,18 +391,28 @@ class MeshSurface:
         col = (v[:, 0] - grid.x_min) / grid.res - 0.5
         row = (grid.y_max - v[:, 1]) / grid.res - 0.5
         sel = self._faces_in(col, row, 0, 0, grid.cols, grid.rows)
-        _top_raster(np.ascontiguousarray(col), np.ascontiguousarray(row), np.ascontiguousarray(v[:, 2]),
-                    self.faces[sel], out)
+        _top_raster(
+            np.ascontiguousarray(col),
+            np.ascontiguousarray(row),
+            np.ascontiguousarray(v[:, 2]),
+            self.faces[sel],
+            out,
+        )
         return out
 
     def _faces_in(self, col, row, c0, r0, c1, r1) -> np.ndarray:
         fc = col[self.faces]
         fr = row[self.faces]
-        return (fc.max(axis=1) >= c0 - 1) & (fc.min(axis=1) <= c1) & (fr.max(axis=1) >= r0 - 1) & (
-            fr.min(axis=1) <= r1)
+        return (
+            (fc.max(axis=1) >= c0 - 1)
+            & (fc.min(axis=1) <= c1)
+            & (fr.max(axis=1) >= r0 - 1)
+            & (fr.min(axis=1) <= r1)
+        )
 
-    def triangles(self, grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform,
-                  wall_min: float) -> Triangles:
+    def triangles(
+        self, grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform, wall_min: float
+    ) -> Triangles:
         v = self._in_crs(grid.crs)
         col = (v[:, 0] - grid.x_min) / grid.res - 0.5
         row = (grid.y_max - v[:, 1]) / grid.res - 0.5
@@ -396,8 +433,9 @@ def open_surface(surface, name: str = "SURFACE"):
     if hasattr(surface, "vertices") and hasattr(surface, "faces"):
         return MeshSurface(surface.vertices, surface.faces, getattr(surface, "crs", None), name)
     if not isinstance(surface, str | os.PathLike):
-        raise InputError(f"{name}: expected a DSM GeoTIFF, a PLY/OBJ mesh or a mesh object, got "
-                         f"{type(surface).__name__}")
+        raise InputError(
+            f"{name}: expected a DSM GeoTIFF, a PLY/OBJ mesh or a mesh object, got {type(surface).__name__}"
+        )
     p = os.fspath(surface)
     if p.lower().endswith(MESH_EXTENSIONS):
         if not os.path.isfile(p):
@@ -405,8 +443,10 @@ def open_surface(surface, name: str = "SURFACE"):
         try:
             from ..surface.meshio import read_mesh  # type: ignore[import-not-found]
         except ImportError:
-            raise InputError(f"{name}: reading PLY/OBJ meshes needs core/surface/meshio.py, which this "
-                             "installation lacks; give a DSM GeoTIFF instead") from None
+            raise InputError(
+                f"{name}: reading PLY/OBJ meshes needs core/surface/meshio.py, which this "
+                "installation lacks; give a DSM GeoTIFF instead"
+            ) from None
         m = read_mesh(p)
         return MeshSurface(m.vertices, m.faces, getattr(m, "crs", None), name)
     if not p.lower().endswith((".tif", ".tiff", ".vrt", ".img")):

@@ -73,10 +73,20 @@ def image_boxes(images, cameras, zmin: float, zmax: float) -> np.ndarray:
     return out
 
 
-def prepare_views(orientation, surface, to_local: PlanTransform, res: float, max_view_deg: float,
-                  visibility: bool, tol_factor: float, oversample: float, wall_min: float,
-                  discontinuity: float = 0.5, edge_shift: float = 0.75,
-                  max_margin_cells: int = 4096) -> ViewSetup:
+def prepare_views(
+    orientation,
+    surface,
+    to_local: PlanTransform,
+    res: float,
+    max_view_deg: float,
+    visibility: bool,
+    tol_factor: float,
+    oversample: float,
+    wall_min: float,
+    discontinuity: float = 0.5,
+    edge_shift: float = 0.75,
+    max_margin_cells: int = 4096,
+) -> ViewSetup:
     images = list(orientation.images)
     cams = [orientation.camera_of(im) for im in images]
     lo, hi = surface.height_range()
@@ -87,8 +97,21 @@ def prepare_views(orientation, surface, to_local: PlanTransform, res: float, max
         margin = int(math.ceil((zmax - zmin) * math.tan(max_view) / res)) + 2
         margin = min(margin, max_margin_cells)
     boxes = image_boxes(images, cams, zmin, zmax)
-    return ViewSetup(images, cams, boxes, zmin, zmax, max_view, margin, visibility, tol_factor, oversample,
-                     wall_min, max(float(discontinuity), 2.0 * res), float(edge_shift))
+    return ViewSetup(
+        images,
+        cams,
+        boxes,
+        zmin,
+        zmax,
+        max_view,
+        margin,
+        visibility,
+        tol_factor,
+        oversample,
+        wall_min,
+        max(float(discontinuity), 2.0 * res),
+        float(edge_shift),
+    )
 
 
 @dataclass
@@ -166,15 +189,16 @@ def edge_shift(h: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
     return dx, dy
 
 
-def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local: PlanTransform,
-               workers: int = 1) -> TileViews:
+def tile_views(
+    setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local: PlanTransform, workers: int = 1
+) -> TileViews:
     """Visibility and view quality of the outer window of ``tile`` (module docstring)."""
     res = grid.res
     outer = tile.outer_grid(grid)
     M = setup.margin_cells
     region = grid.window(tile.outer[0] - M, tile.outer[1] - M, tile.outer[2] + 2 * M, tile.outer[3] + 2 * M)
     hreg = surface.heights_on(region)
-    h = hreg[M: M + outer.rows, M: M + outer.cols]
+    h = hreg[M : M + outer.rows, M : M + outer.cols]
     rows, cols = h.shape
     valid = np.isfinite(h)
     X, Y = outer.centres()
@@ -182,9 +206,16 @@ def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local
     lz = h - to_local.offset[2]
     P = np.column_stack([lx.ravel(), ly.ravel(), np.where(valid, lz, 0.0).ravel()])
     vflat = valid.ravel()
-    empty = TileViews(outer, h, np.zeros(0, np.int64), np.zeros((0, rows, cols), bool),
-                      np.zeros((0, rows, cols), bool), np.zeros((0, rows, cols, 2), np.float32),
-                      np.zeros((0, rows, cols), np.float32), np.zeros(0))
+    empty = TileViews(
+        outer,
+        h,
+        np.zeros(0, np.int64),
+        np.zeros((0, rows, cols), bool),
+        np.zeros((0, rows, cols), bool),
+        np.zeros((0, rows, cols, 2), np.float32),
+        np.zeros((0, rows, cols), np.float32),
+        np.zeros(0),
+    )
     if not vflat.any():
         return empty
     bx0, by0 = float(lx[valid].min()), float(ly[valid].min())
@@ -198,7 +229,7 @@ def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local
     tris = None
     if setup.visibility:
         zlow = float(np.nanmin(h))
-        rr, cc = np.mgrid[0:region.rows, 0:region.cols]
+        rr, cc = np.mgrid[0 : region.rows, 0 : region.cols]
         dr = np.maximum(np.maximum(M - rr, rr - (M + rows - 1)), 0)
         dc = np.maximum(np.maximum(M - cc, cc - (M + cols - 1)), 0)
         dist = np.hypot(dr, dc) * res
@@ -219,7 +250,10 @@ def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local
             slx, sly = to_local.xy(sx[moved], sy[moved])
             # height along the cell's own slope
             nz = normals3[..., 2][moved]
-            sz = lz[moved] - delta * (normals3[..., 0][moved] * ex[moved] + normals3[..., 1][moved] * ey[moved]) / nz
+            sz = (
+                lz[moved]
+                - delta * (normals3[..., 0][moved] * ex[moved] + normals3[..., 1][moved] * ey[moved]) / nz
+            )
             S = P.copy()
             mi = np.flatnonzero(moved.ravel())
             S[mi, 0], S[mi, 1], S[mi, 2] = slx, sly, sz
@@ -239,8 +273,13 @@ def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local
         # cells projected with the full camera to find the buffer window
         uvz = project(P[ok], im.R, im.C, cam)
         uvp, depth = uvz[:, :2], uvz[:, 2]
-        inside = (depth > 0) & (uvp[:, 0] >= -0.5) & (uvp[:, 0] <= cam.width - 0.5) & (uvp[:, 1] >= -0.5) & (
-            uvp[:, 1] <= cam.height - 0.5)
+        inside = (
+            (depth > 0)
+            & (uvp[:, 0] >= -0.5)
+            & (uvp[:, 0] <= cam.width - 0.5)
+            & (uvp[:, 1] >= -0.5)
+            & (uvp[:, 1] <= cam.height - 0.5)
+        )
         if not inside.any():
             return None
         idx = np.flatnonzero(ok)[inside]
@@ -283,8 +322,8 @@ def tile_views(setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local
     if workers > 1 and len(cand_all) > 1:
         from concurrent.futures import ThreadPoolExecutor
 
-        with ThreadPoolExecutor(max_workers=workers) as ex:
-            results = list(ex.map(one, cand_all))
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            results = list(pool.map(one, cand_all))
     else:
         results = [one(k) for k in cand_all]
     keep = [i for i, r in enumerate(results) if r is not None and r[0].any()]

@@ -196,8 +196,14 @@ def valid_radius2(camera: Camera, margin: float = 3.0) -> float:
     ``r (1 + k1 r^2 + k2 r^4 + k3 r^6)`` stops increasing: beyond that radius
     far-away points would fold back into the frame.
     """
-    corners = np.array([[-0.5, -0.5], [camera.width - 0.5, -0.5], [-0.5, camera.height - 0.5],
-                        [camera.width - 0.5, camera.height - 0.5]])
+    corners = np.array(
+        [
+            [-0.5, -0.5],
+            [camera.width - 0.5, -0.5],
+            [-0.5, camera.height - 0.5],
+            [camera.width - 0.5, camera.height - 0.5],
+        ]
+    )
     xy = np.column_stack([(corners[:, 0] - camera.cx) / camera.fx, (corners[:, 1] - camera.cy) / camera.fy])
     r_corner = float(np.max(np.hypot(xy[:, 0], xy[:, 1])))
     r = np.linspace(0.0, max(10.0, 2 * margin * r_corner), 40001)
@@ -358,8 +364,9 @@ def project(points, R, C, camera: Camera, scale: float = 1.0) -> np.ndarray:
     return uvz
 
 
-def render_depth(tris: Triangles, R, C, camera: Camera, window, scale: float = 1.0,
-                 cull: bool | None = None) -> np.ndarray:
+def render_depth(
+    tris: Triangles, R, C, camera: Camera, window, scale: float = 1.0, cull: bool | None = None
+) -> np.ndarray:
     """Depth buffer of the triangles in one image window.
 
     Parameters
@@ -429,8 +436,22 @@ def point_visibility(points, tol, R, C, camera: Camera, zbuf: np.ndarray, window
     u = np.empty(n)
     v = np.empty(n)
     z = np.empty(n)
-    _visibility(P, t, Rm, Cv, scaled_params(camera, scale), valid_radius2(camera), zbuf, float(x0), float(y0),
-                vis, edge, u, v, z)
+    _visibility(
+        P,
+        t,
+        Rm,
+        Cv,
+        scaled_params(camera, scale),
+        valid_radius2(camera),
+        zbuf,
+        float(x0),
+        float(y0),
+        vis,
+        edge,
+        u,
+        v,
+        z,
+    )
     s = float(scale)
     uv = np.column_stack([(u + 0.5) / s - 0.5, (v + 0.5) / s - 0.5])
     return vis.astype(bool), edge.astype(bool), uv, z

@@ -57,9 +57,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
-            QgsProcessingParameterFile(
-                self.ORIENTATION, tr("Orientation (TruOrtho JSON)"), extension="json"
-            )
+            QgsProcessingParameterFile(self.ORIENTATION, tr("Orientation (TruOrtho JSON)"), extension="json")
         )
         self.add(
             QgsProcessingParameterFile(
@@ -68,7 +66,9 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 fileFilter=tr("Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;All files (*.*)"),
             )
         )
-        self.add(QgsProcessingParameterExtent(self.EXTENT, tr("Extent (default: the surface's)"), optional=True))
+        self.add(
+            QgsProcessingParameterExtent(self.EXTENT, tr("Extent (default: the surface's)"), optional=True)
+        )
         self.add(
             QgsProcessingParameterNumber(
                 self.RESOLUTION,
@@ -78,7 +78,9 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 minValue=0.0,
             )
         )
-        self.add(QgsProcessingParameterCrs(self.CRS, tr("Output CRS (default: the orientation's)"), optional=True))
+        self.add(
+            QgsProcessingParameterCrs(self.CRS, tr("Output CRS (default: the orientation's)"), optional=True)
+        )
         self.add(QgsProcessingParameterBoolean(self.COLOR_CORRECTION, tr("Colour correction"), True))
         self.add(
             QgsProcessingParameterNumber(

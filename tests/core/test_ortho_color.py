@@ -45,8 +45,12 @@ def test_estimate_recovers_relative_gains_with_outliers():
     corr = estimate_corrections(np.array(cells), np.array(imgs), np.array(vals), n_img)
     assert np.allclose(corr.gain, g_true, atol=0.01)
     assert np.allclose(corr.offset, o_true, atol=0.6)
-    assert all(a < 0.3 * b for a, b in zip(corr.stats["median_after"], corr.stats["median_before"], strict=True))
-    assert np.allclose(corr.gain.mean(axis=0), 1.0, atol=1e-3) and np.allclose(corr.offset.mean(axis=0), 0, atol=1e-2)
+    assert all(
+        a < 0.3 * b for a, b in zip(corr.stats["median_after"], corr.stats["median_before"], strict=True)
+    )
+    assert np.allclose(corr.gain.mean(axis=0), 1.0, atol=1e-3) and np.allclose(
+        corr.offset.mean(axis=0), 0, atol=1e-2
+    )
 
 
 def test_apply_keeps_the_range_of_the_dtype():

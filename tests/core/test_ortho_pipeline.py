@@ -37,8 +37,13 @@ def data(tmp_path_factory):
     grid = RasterGrid.from_geotransform(gt, h.shape[0], h.shape[1], cfg.crs)
     truth, _ = scene.orthophoto(res)
     return {
-        "scene": scene, "folder": folder, "grid": grid, "truth": truth, "res": res,
-        "buildings": ev.building_mask(scene, grid), "seen": ev.truth_seen(scene, grid, 45.0),
+        "scene": scene,
+        "folder": folder,
+        "grid": grid,
+        "truth": truth,
+        "res": res,
+        "buildings": ev.building_mask(scene, grid),
+        "seen": ev.truth_seen(scene, grid, 45.0),
     }
 
 
@@ -49,15 +54,27 @@ def _measures(d, path, band_cells=2.0):
     truth = d["truth"]
     gh = ev.ghosting(rgb, truth, valid, d["buildings"], band_cells)
     sh = ev.phase_shift(rgb.astype(float).mean(-1) / 255, truth.astype(float).mean(-1) / 255, valid)
-    return {"ghost": gh["share"], "band_cells": gh["cells"], "shift": sh["median"], "shift_tiles": sh["tiles"],
-            "coverage": ev.coverage(valid, d["seen"]), "dE": ev.mean_delta_e(rgb, truth, valid)}
+    return {
+        "ghost": gh["share"],
+        "band_cells": gh["cells"],
+        "shift": sh["median"],
+        "shift_tiles": sh["tiles"],
+        "coverage": ev.coverage(valid, d["seen"]),
+        "dE": ev.mean_delta_e(rgb, truth, valid),
+    }
 
 
 def _run(d, name, **kw):
     f = d["folder"]
     cfg = TrueOrthoConfig(**kw)
-    return true_ortho(f / "orientation.json", f / "dsm.tif", f / f"{name}.tif", f / f"{name}_idx.tif",
-                      f / f"{name}_occ.tif", cfg)
+    return true_ortho(
+        f / "orientation.json",
+        f / "dsm.tif",
+        f / f"{name}.tif",
+        f / f"{name}_idx.tif",
+        f / f"{name}_occ.tif",
+        cfg,
+    )
 
 
 def test_acceptance_against_truth_and_conventional(data):
@@ -75,7 +92,10 @@ def test_acceptance_against_truth_and_conventional(data):
         assert m["shift"] <= 0.3  # cells = GSD here
         assert m["coverage"] >= 0.99
     assert m_cc["dE"] < m_raw["dE"]
-    assert true_cc.stats["color_correction"]["median_after"][0] < true_cc.stats["color_correction"]["median_before"][0]
+    assert (
+        true_cc.stats["color_correction"]["median_after"][0]
+        < true_cc.stats["color_correction"]["median_before"][0]
+    )
 
 
 def test_outputs_are_cogs_with_index_occlusion_and_seamlines(data):
@@ -128,8 +148,12 @@ def test_bad_input_gives_clear_errors_and_no_output(data, tmp_path):
     ext = data["scene"].extent_world()
     out = tmp_path / "o.tif"
     with pytest.raises(InputError, match="SURFACE.*covers"):
-        true_ortho(f / "orientation.json", f / "dsm.tif", out, config=TrueOrthoConfig(
-            extent=(ext[0] - 50, ext[1], ext[2], ext[3])))
+        true_ortho(
+            f / "orientation.json",
+            f / "dsm.tif",
+            out,
+            config=TrueOrthoConfig(extent=(ext[0] - 50, ext[1], ext[2], ext[3])),
+        )
     with pytest.raises(CRSError, match="no transformation"):
         true_ortho(f / "orientation.json", f / "dsm.tif", out, config=TrueOrthoConfig(crs="IAU_2015:49910"))
     # images missing on disk
@@ -143,8 +167,14 @@ def test_bad_input_gives_clear_errors_and_no_output(data, tmp_path):
     calls = []
     prog = CallbackProgress(lambda fr, m: calls.append(fr), lambda: len(calls) > 3)
     with pytest.raises(CancelledError):
-        true_ortho(f / "orientation.json", f / "dsm.tif", out, tmp_path / "i.tif",
-                   config=TrueOrthoConfig(tile_size=64, color_correction=False), progress=prog)
+        true_ortho(
+            f / "orientation.json",
+            f / "dsm.tif",
+            out,
+            tmp_path / "i.tif",
+            config=TrueOrthoConfig(tile_size=64, color_correction=False),
+            progress=prog,
+        )
     assert sorted(os.listdir(tmp_path)) == []
 
 
@@ -163,8 +193,15 @@ def test_single_band_16_bit_and_float_keep_dtype_and_bands(data, tmp_path):
             name = im.name.replace(".png", ".tif")
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", rasterio.errors.NotGeoreferencedWarning)
-                with rasterio.open(root / name, "w", driver="GTiff", width=img.shape[1], height=img.shape[0],
-                                   count=1, dtype=dtype) as ds:
+                with rasterio.open(
+                    root / name,
+                    "w",
+                    driver="GTiff",
+                    width=img.shape[1],
+                    height=img.shape[0],
+                    count=1,
+                    dtype=dtype,
+                ) as ds:
                     ds.write(val[None])
             images.append(dataclasses.replace(im, path=name))
         o2 = dataclasses.replace(o, images=images, image_root=str(root))
@@ -197,9 +234,15 @@ def test_reprojected_output_matches_the_warped_truth(data, tmp_path):
     assert r.stats["reprojected"] and r.grid.crs == "EPSG:32633"
     a, g, _ = read_raster(r.output, band=None)
     truth = np.zeros((3,) + g.shape, np.uint8)
-    reproject(np.moveaxis(data["truth"], -1, 0), truth, src_transform=data["grid"].transform,
-              src_crs="EPSG:32632", dst_transform=g.transform, dst_crs="EPSG:32633",
-              resampling=Resampling.nearest)
+    reproject(
+        np.moveaxis(data["truth"], -1, 0),
+        truth,
+        src_transform=data["grid"].transform,
+        src_crs="EPSG:32632",
+        dst_transform=g.transform,
+        dst_crs="EPSG:32633",
+        resampling=Resampling.nearest,
+    )
     valid = (a[3] > 0) & (truth.sum(axis=0) > 0)
     t = np.moveaxis(truth, 0, -1)
     rgb = np.moveaxis(a[:3], 0, -1)
@@ -218,7 +261,9 @@ def test_mesh_surface_gives_the_dsm_result(data, tmp_path):
     cfg = TrueOrthoConfig(extent=sub, resolution=data["res"], color_correction=False)
     f = data["folder"]
     rm = true_ortho(f / "orientation.json", mesh, tmp_path / "m.tif", tmp_path / "mi.tif", config=cfg)
-    rd = true_ortho(f / "orientation.json", f / "dsm.tif", tmp_path / "d.tif", tmp_path / "di.tif", config=cfg)
+    rd = true_ortho(
+        f / "orientation.json", f / "dsm.tif", tmp_path / "d.tif", tmp_path / "di.tif", config=cfg
+    )
     im_, _, _ = read_raster(rm.source_index)
     id_, _, _ = read_raster(rd.source_index)
     assert (im_ == id_).mean() > 0.95

@@ -20,7 +20,8 @@ from truortho.core.synthetic import SceneConfig, make_scene
 from truortho.core.synthetic.cameras import look_at_rotation
 
 
-def test_dsm_triangles_tops_up_walls_face_the_lower_cell(rng=np.random.default_rng(3)):
+def test_dsm_triangles_tops_up_walls_face_the_lower_cell():
+    rng = np.random.default_rng(3)
     h = np.round(rng.uniform(0, 3, (6, 7)), 1)
     h[2, 3] = np.nan
     tris = dsm_triangles(h, 10.0, 20.0, 0.5)
@@ -33,10 +34,12 @@ def test_dsm_triangles_tops_up_walls_face_the_lower_cell(rng=np.random.default_r
     # every wall: the cell on its normal side is the lower one
     centre = v[walls].mean(axis=1)
     for c, nn in zip(centre, n[walls], strict=True):
+
         def cell_h(p):
             col = int(np.floor((p[0] - 10.0) / 0.5))
             row = int(np.floor((20.0 - p[1]) / 0.5))
             return h[row, col]
+
         front = cell_h(c[:2] + 0.25 * nn[:2])
         back = cell_h(c[:2] - 0.25 * nn[:2])
         assert front < back
