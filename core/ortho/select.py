@@ -172,52 +172,95 @@ def _pair_cost(a, b, r0, c0, r1, c1, w, lum, contrast):
     if a == b:
         return 0.0
     d = 0.0
-    la = lum[a, r0, c0]
-    lb = lum[b, r0, c0]
+    la = lum[r0, c0, a]
+    lb = lum[r0, c0, b]
     d += abs(la - lb) if (la == la and lb == lb) else 1.0
-    la = lum[a, r1, c1]
-    lb = lum[b, r1, c1]
+    la = lum[r1, c1, a]
+    lb = lum[r1, c1, b]
     d += abs(la - lb) if (la == la and lb == lb) else 1.0
     return w * (1.0 + contrast * d)
 
 
 @njit
+def _local_energy(k, r, c, labels, cost, lum, wh, wv, smooth, contrast, rows, cols):
+    e = cost[r, c, k]
+    if c > 0:
+        q = labels[r, c - 1]
+        if q >= 0:
+            e += smooth * _pair_cost(k, q, r, c, r, c - 1, wh[r, c - 1], lum, contrast)
+    if c < cols - 1:
+        q = labels[r, c + 1]
+        if q >= 0:
+            e += smooth * _pair_cost(k, q, r, c, r, c + 1, wh[r, c], lum, contrast)
+    if r > 0:
+        q = labels[r - 1, c]
+        if q >= 0:
+            e += smooth * _pair_cost(k, q, r, c, r - 1, c, wv[r - 1, c], lum, contrast)
+    if r < rows - 1:
+        q = labels[r + 1, c]
+        if q >= 0:
+            e += smooth * _pair_cost(k, q, r, c, r + 1, c, wv[r, c], lum, contrast)
+    return e
+
+
+@njit
 def _icm(labels, frozen, cost, lum, wh, wv, smooth, contrast, sweeps):
-    K = cost.shape[0]
+    """ICM sweeps; ``cost`` and ``lum`` are (rows, cols, K) (cell-major for locality).
+
+    The labels tried at a cell are its current one, its data-best one and those of
+    its four neighbours: any other label pays a seam to every neighbour for no gain
+    in the data term.
+    """
+    K = cost.shape[2]
     rows = labels.shape[0]
     cols = labels.shape[1]
+    best_data = np.full((rows, cols), -1, np.int64)
+    free = np.zeros((rows, cols), np.bool_)
+    for r in range(rows):
+        for c in range(cols):
+            if labels[r, c] < 0 or frozen[r, c]:
+                continue
+            n = 0
+            bd = -1
+            bv = np.inf
+            for k in range(K):
+                v = cost[r, c, k]
+                if v < np.inf:
+                    n += 1
+                    if v < bv:
+                        bv = v
+                        bd = k
+            free[r, c] = n > 1
+            best_data[r, c] = bd
+    cand = np.empty(6, np.int64)
     total_changes = 0
     for _ in range(sweeps):
         changes = 0
         for r in range(rows):
             for c in range(cols):
-                cur = labels[r, c]
-                if cur < 0 or frozen[r, c]:
+                if not free[r, c]:
                     continue
+                cur = labels[r, c]
+                cand[0] = cur
+                cand[1] = best_data[r, c]
+                cand[2] = labels[r, c - 1] if c > 0 else -1
+                cand[3] = labels[r, c + 1] if c < cols - 1 else -1
+                cand[4] = labels[r - 1, c] if r > 0 else -1
+                cand[5] = labels[r + 1, c] if r < rows - 1 else -1
                 best = cur
-                best_e = np.inf
-                for k in range(K):
-                    dk = cost[k, r, c]
-                    if not dk < np.inf:
+                best_e = _local_energy(cur, r, c, labels, cost, lum, wh, wv, smooth, contrast, rows, cols)
+                for m in range(1, 6):
+                    k = cand[m]
+                    if k < 0 or k == cur or not cost[r, c, k] < np.inf:
                         continue
-                    e = dk
-                    if c > 0:
-                        q = labels[r, c - 1]
-                        if q >= 0:
-                            e += smooth * _pair_cost(k, q, r, c, r, c - 1, wh[r, c - 1], lum, contrast)
-                    if c < cols - 1:
-                        q = labels[r, c + 1]
-                        if q >= 0:
-                            e += smooth * _pair_cost(k, q, r, c, r, c + 1, wh[r, c], lum, contrast)
-                    if r > 0:
-                        q = labels[r - 1, c]
-                        if q >= 0:
-                            e += smooth * _pair_cost(k, q, r, c, r - 1, c, wv[r - 1, c], lum, contrast)
-                    if r < rows - 1:
-                        q = labels[r + 1, c]
-                        if q >= 0:
-                            e += smooth * _pair_cost(k, q, r, c, r + 1, c, wv[r, c], lum, contrast)
-                    if e < best_e - 1e-7 or (k == cur and e <= best_e + 1e-7):
+                    seen_before = False
+                    for mm in range(1, m):
+                        if cand[mm] == k:
+                            seen_before = True
+                    if seen_before:
+                        continue
+                    e = _local_energy(k, r, c, labels, cost, lum, wh, wv, smooth, contrast, rows, cols)
+                    if e < best_e - 1e-7:
                         best_e = e
                         best = k
                 if best != cur:
@@ -284,8 +327,8 @@ def select_labels(
     _icm(
         labels,
         frozen,
-        np.ascontiguousarray(cost, dtype=np.float32),
-        np.ascontiguousarray(lum, dtype=np.float32),
+        np.ascontiguousarray(np.moveaxis(cost, 0, -1), dtype=np.float32),
+        np.ascontiguousarray(np.moveaxis(lum, 0, -1), dtype=np.float32),
         wh,
         wv,
         float(smoothness),

@@ -296,11 +296,7 @@ def grid_triangles(
             heights - o[2], grid.x_min - o[0], grid.y_max - o[1], grid.res, include, wall_min
         )
     tris = dsm_triangles(heights, grid.x_min, grid.y_max, grid.res, include, wall_min)
-    used = np.unique(tris.faces)
-    v = tris.vertices
-    if len(used):
-        v = v.copy()
-        v[used] = to_local.vertices(v[used])
+    v = to_local.vertices(tris.vertices) if len(tris.vertices) else tris.vertices
     return Triangles(v, tris.faces, True)
 
 

@@ -33,7 +33,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..geometry.camera import Camera
-from ..geometry.footprint import footprint_on_plane
 from ..grid import RasterGrid, Tile
 from .surface import PlanTransform
 from .zbuffer import depth_tolerance, point_visibility, project, render_depth
@@ -59,17 +58,41 @@ class ViewSetup:
 
 
 def image_boxes(images, cameras, zmin: float, zmax: float) -> np.ndarray:
-    """Local plan bounding boxes (n, 4) of every image's footprint between heights zmin and zmax."""
+    """Local plan bounding boxes (n, 4) of every image's footprint between heights zmin and zmax.
+
+    The frame outline (8 samples per edge) is cast onto both planes; rays above
+    the horizon are cut at 20 times the height above the plane (as
+    :func:`~truortho.core.geometry.footprint.footprint_on_plane`). NaN rows: the
+    image sees neither plane.
+    """
+    from ..geometry.camera import undistort_points
+    from ..geometry.footprint import frame_outline
+
+    rays: dict[int, np.ndarray] = {}
     out = np.full((len(images), 4), np.nan)
     for k, (im, cam) in enumerate(zip(images, cameras, strict=True)):
+        key = id(cam)
+        if key not in rays:
+            xy = undistort_points(frame_outline(cam, 8), cam)
+            rays[key] = np.column_stack([xy, np.ones(len(xy))])[np.all(np.isfinite(xy), axis=1)]
+        d = rays[key] @ im.R  # R^T d_cam, row-wise
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
         pts = []
         for z in (zmin, zmax):
-            fp = footprint_on_plane(im.R, im.C, cam, z, samples_per_edge=8)
-            if fp is not None:
-                pts.append(fp)
+            hgt = im.C[2] - z
+            reach = 20.0 * max(abs(hgt), 1.0)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = (z - im.C[2]) / d[:, 2]
+            hit = t > 0
+            horiz = d[:, :2] / np.maximum(np.linalg.norm(d[:, :2], axis=1, keepdims=True), 1e-12)
+            p = np.where(hit[:, None], d[:, :2] * np.where(hit, t, 0.0)[:, None], horiz * reach)
+            r = np.linalg.norm(p, axis=1, keepdims=True)
+            p = np.where(r > reach, p / np.maximum(r, 1e-12) * reach, p)
+            if hit.any():
+                pts.append(p + im.C[:2])
         if pts:
-            p = np.vstack(pts)
-            out[k] = [p[:, 0].min(), p[:, 1].min(), p[:, 0].max(), p[:, 1].max()]
+            q = np.vstack(pts)
+            out[k] = [q[:, 0].min(), q[:, 1].min(), q[:, 0].max(), q[:, 1].max()]
     return out
 
 
@@ -258,32 +281,32 @@ def tile_views(
             mi = np.flatnonzero(moved.ravel())
             S[mi, 0], S[mi, 1], S[mi, 2] = slx, sly, sz
 
+    vidx = np.flatnonzero(vflat)
+    Pv = P[vidx]
+    cos_max = math.cos(setup.max_view)
+
     def one(k):
         im = setup.images[k]
         cam = setup.cameras[k]
-        d = im.C[None, :] - P
-        dist = np.linalg.norm(d, axis=1)
+        # cells inside the frame first (one cheap projection), everything else on that subset
+        uvz = project(Pv, im.R, im.C, cam)
+        u, v, depth = uvz[:, 0], uvz[:, 1], uvz[:, 2]
+        inside = (depth > 0) & (u >= -0.5) & (u <= cam.width - 0.5) & (v >= -0.5) & (v <= cam.height - 0.5)
+        sub = np.flatnonzero(inside)
+        if not len(sub):
+            return None
+        d = im.C[None, :] - Pv[sub]
+        dist = np.sqrt(np.einsum("ij,ij->i", d, d))
         ray = d / np.maximum(dist, 1e-9)[:, None]
         cos_view = ray[:, 2]
-        ok = vflat & (cos_view >= math.cos(setup.max_view))
+        ok = cos_view >= cos_max
         if not ok.any():
             return None
-        gsd = float(np.median(dist[ok] / cam.fx))
+        sub, d, dist, ray, cos_view = sub[ok], d[ok], dist[ok], ray[ok], cos_view[ok]
+        idx = vidx[sub]
+        gsd = float(np.median(dist / cam.fx))
         scale = min(1.0, setup.oversample * gsd / res) if setup.visibility else 1.0
-        # cells projected with the full camera to find the buffer window
-        uvz = project(P[ok], im.R, im.C, cam)
-        uvp, depth = uvz[:, :2], uvz[:, 2]
-        inside = (
-            (depth > 0)
-            & (uvp[:, 0] >= -0.5)
-            & (uvp[:, 0] <= cam.width - 0.5)
-            & (uvp[:, 1] >= -0.5)
-            & (uvp[:, 1] <= cam.height - 0.5)
-        )
-        if not inside.any():
-            return None
-        idx = np.flatnonzero(ok)[inside]
-        uvb = (uvp[inside] + 0.5) * scale - 0.5
+        uvb = (uvz[sub, :2] + 0.5) * scale - 0.5
         bw = max(1, int(round(cam.width * scale)))
         bh = max(1, int(round(cam.height * scale)))
         x0 = max(int(math.floor(uvb[:, 0].min())) - 2, 0)
@@ -291,33 +314,28 @@ def tile_views(
         x1 = min(int(math.ceil(uvb[:, 0].max())) + 2, bw - 1)
         y1 = min(int(math.ceil(uvb[:, 1].max())) + 2, bh - 1)
         win = (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
-        Pk = P[idx]
-        tan_view = np.sqrt(np.maximum(1.0 - cos_view[idx] ** 2, 0.0)) / np.maximum(cos_view[idx], 1e-6)
-        usable = np.zeros(len(P), bool)
-        edge = np.zeros(len(P), bool)
-        uv = np.full((len(P), 2), np.nan, np.float32)
+        cos_inc = np.einsum("ij,ij->i", normals[idx], ray)
+        good = cos_inc > 0.02  # the surface faces the camera
         if setup.visibility:
             zb = render_depth(tris, im.R, im.C, cam, win, scale)
-            foot = dist[idx] / (cam.fx * scale) / np.maximum(cos_view[idx], 1e-6)
+            cv = np.maximum(cos_view, 1e-6)
+            tan_view = np.sqrt(np.maximum(1.0 - cos_view**2, 0.0)) / cv
+            foot = dist / (cam.fx * scale) / cv
             tol = depth_tolerance(res, foot, tan_view, setup.tol_factor)
-            vis, ne, uvk, _ = point_visibility(Pk, tol, im.R, im.C, cam, zb, win, scale)
-            usable[idx] = vis
-            edge[idx] = ne & vis
+            vis, ne, _, _ = point_visibility(P[idx], tol, im.R, im.C, cam, zb, win, scale)
+            good &= vis
+            ne &= good
         else:
-            usable[idx] = True
+            ne = np.zeros(len(idx), bool)
         uvs = project(S[idx], im.R, im.C, cam)
-        good = uvs[:, 2] > 0
-        uv[idx[good]] = uvs[good, :2]
-        usable[idx[~good]] = False
-        if setup.visibility:
-            # next to an occluder: the nearest pixel (the one that passed the depth test) instead of a
-            # bilinear mix with the occluder's pixels
-            ne_i = np.flatnonzero(edge)
-            uv[ne_i] = np.round(uv[ne_i])
-        cos_inc = np.einsum("ij,ij->i", normals, ray)
-        usable &= cos_inc > 0.02
-        eff = np.where(usable, dist / (cam.fx * np.maximum(cos_inc, 0.02)), np.inf).astype(np.float32)
-        return usable, edge, uv, eff, gsd
+        good &= uvs[:, 2] > 0
+        uvk = uvs[:, :2].astype(np.float32)
+        # next to an occluder: the nearest pixel (the one that passed the depth test) instead of a
+        # bilinear mix with the occluder's pixels
+        uvk[ne] = np.round(uvk[ne])
+        gi = idx[good]
+        eff = (dist[good] / (cam.fx * cos_inc[good])).astype(np.float32)
+        return gi, ne[good], uvk[good], eff, gsd
 
     if workers > 1 and len(cand_all) > 1:
         from concurrent.futures import ThreadPoolExecutor
@@ -326,13 +344,24 @@ def tile_views(
             results = list(pool.map(one, cand_all))
     else:
         results = [one(k) for k in cand_all]
-    keep = [i for i, r in enumerate(results) if r is not None and r[0].any()]
+    keep = [i for i, r in enumerate(results) if r is not None and len(r[0])]
     if not keep:
         return empty
     K = len(keep)
-    usable = np.stack([results[i][0] for i in keep]).reshape(K, rows, cols)
-    edge = np.stack([results[i][1] for i in keep]).reshape(K, rows, cols)
-    uv = np.stack([results[i][2] for i in keep]).reshape(K, rows, cols, 2)
-    eff = np.stack([results[i][3] for i in keep]).reshape(K, rows, cols)
+    n = rows * cols
+    usable = np.zeros((K, n), bool)
+    edge = np.zeros((K, n), bool)
+    uv = np.full((K, n, 2), np.nan, np.float32)
+    eff = np.full((K, n), np.inf, np.float32)
+    for k, i in enumerate(keep):
+        gi, ne, uvk, ek, _ = results[i]
+        usable[k, gi] = True
+        edge[k, gi] = ne
+        uv[k, gi] = uvk
+        eff[k, gi] = ek
+    usable = usable.reshape(K, rows, cols)
+    edge = edge.reshape(K, rows, cols)
+    uv = uv.reshape(K, rows, cols, 2)
+    eff = eff.reshape(K, rows, cols)
     gsd = np.array([results[i][4] for i in keep])
     return TileViews(outer, h, cand_all[keep], usable, edge, uv, eff, gsd, 0 if tris is None else len(tris))

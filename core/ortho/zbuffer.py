@@ -108,8 +108,8 @@ def dsm_triangles(heights, x_min: float, y_max: float, res: float, include=None,
     Returns
     -------
     Triangles
-        Vertex ``4 * (r * cols + c) + k`` is corner ``k`` (NW, NE, SE, SW) of
-        cell ``(r, c)`` at its height.
+        Four vertices (corners NW, NE, SE, SW at the cell's height) for every
+        cell a face uses, in row-major cell order.
     """
     h = np.asarray(heights, dtype=np.float64)
     if h.ndim != 2:
@@ -119,48 +119,44 @@ def dsm_triangles(heights, x_min: float, y_max: float, res: float, include=None,
     rows, cols = h.shape
     valid = np.isfinite(h)
     inc = valid if include is None else (np.asarray(include, dtype=bool) & valid)
-    xs = x_min + np.arange(cols + 1) * res
-    ys = y_max - np.arange(rows + 1) * res
-    verts = np.empty((rows, cols, 4, 3))
-    hz = np.where(valid, h, 0.0)
-    verts[:, :, 0, 0] = xs[None, :-1]
-    verts[:, :, 0, 1] = ys[:-1, None]
-    verts[:, :, 1, 0] = xs[None, 1:]
-    verts[:, :, 1, 1] = ys[:-1, None]
-    verts[:, :, 2, 0] = xs[None, 1:]
-    verts[:, :, 2, 1] = ys[1:, None]
-    verts[:, :, 3, 0] = xs[None, :-1]
-    verts[:, :, 3, 1] = ys[1:, None]
-    verts[:, :, :, 2] = hz[:, :, None]
-    base = (4 * np.arange(rows * cols, dtype=np.int64)).reshape(rows, cols)
+    with np.errstate(invalid="ignore"):
+        step_e = valid[:, :-1] & valid[:, 1:] & (inc[:, :-1] | inc[:, 1:]) & (np.abs(h[:, :-1] - h[:, 1:]) > wall_min)
+        step_s = valid[:-1, :] & valid[1:, :] & (inc[:-1, :] | inc[1:, :]) & (np.abs(h[:-1, :] - h[1:, :]) > wall_min)
+    # only the cells some face uses get vertices
+    need = inc.copy()
+    need[:, :-1] |= step_e
+    need[:, 1:] |= step_e
+    need[:-1, :] |= step_s
+    need[1:, :] |= step_s
+    rr, cc = np.nonzero(need)
+    n = len(rr)
+    base = np.full((rows, cols), -1, np.int64)
+    base[rr, cc] = 4 * np.arange(n, dtype=np.int64)
+    x0 = x_min + cc * res
+    y0 = y_max - rr * res
+    verts = np.empty((n, 4, 3))
+    verts[:, 0, 0], verts[:, 0, 1] = x0, y0
+    verts[:, 1, 0], verts[:, 1, 1] = x0 + res, y0
+    verts[:, 2, 0], verts[:, 2, 1] = x0 + res, y0 - res
+    verts[:, 3, 0], verts[:, 3, 1] = x0, y0 - res
+    verts[:, :, 2] = h[rr, cc][:, None]
     NW, NE, SE, SW = 0, 1, 2, 3
     parts = []
     b = base[inc]
     parts.append(np.column_stack([b + NW, b + SW, b + SE]))
     parts.append(np.column_stack([b + NW, b + SE, b + NE]))
-    # walls between (r, c) = A and (r, c + 1) = B on A's east edge
-    if cols > 1:
-        ha, hb = h[:, :-1], h[:, 1:]
-        both = valid[:, :-1] & valid[:, 1:] & (inc[:, :-1] | inc[:, 1:])
-        with np.errstate(invalid="ignore"):
-            step = both & (np.abs(ha - hb) > wall_min)
-        a = base[:, :-1][step]
-        bb = base[:, 1:][step]
-        # the same index triples face +x when A is higher and -x when B is higher
-        a_ne, a_se, b_nw, b_sw = a + NE, a + SE, bb + NW, bb + SW
-        parts += [np.column_stack([b_sw, b_nw, a_ne]), np.column_stack([b_sw, a_ne, a_se])]
-    # walls between (r, c) = A and (r + 1, c) = B on A's south edge
-    if rows > 1:
-        ha, hb = h[:-1, :], h[1:, :]
-        both = valid[:-1, :] & valid[1:, :] & (inc[:-1, :] | inc[1:, :])
-        with np.errstate(invalid="ignore"):
-            step = both & (np.abs(ha - hb) > wall_min)
-        a = base[:-1, :][step]
-        bb = base[1:, :][step]
-        # faces -y when A is higher, +y when B is higher
-        a_sw, a_se, b_nw, b_ne = a + SW, a + SE, bb + NW, bb + NE
-        parts += [np.column_stack([b_nw, b_ne, a_se]), np.column_stack([b_nw, a_se, a_sw])]
-    faces = np.concatenate(parts).astype(np.int32) if parts else np.zeros((0, 3), np.int32)
+    # walls between (r, c) = A and (r, c + 1) = B on A's east edge;
+    # the same index triples face +x when A is higher and -x when B is higher
+    a = base[:, :-1][step_e]
+    bb = base[:, 1:][step_e]
+    a_ne, a_se, b_nw, b_sw = a + NE, a + SE, bb + NW, bb + SW
+    parts += [np.column_stack([b_sw, b_nw, a_ne]), np.column_stack([b_sw, a_ne, a_se])]
+    # walls between (r, c) = A and (r + 1, c) = B on A's south edge: -y when A is higher, +y otherwise
+    a = base[:-1, :][step_s]
+    bb = base[1:, :][step_s]
+    a_sw, a_se, b_nw, b_ne = a + SW, a + SE, bb + NW, bb + NE
+    parts += [np.column_stack([b_nw, b_ne, a_se]), np.column_stack([b_nw, a_se, a_sw])]
+    faces = np.concatenate(parts).astype(np.int32)
     return Triangles(verts.reshape(-1, 3), faces, oriented=True)
 
 
