@@ -60,10 +60,10 @@ OURS = textwrap.dedent(
     r = true_ortho(folder + "/orientation.json", folder + "/dsm.tif", out, out[:-4] + "_idx.tif",
                    out[:-4] + "_occ.tif", config=cfg)
     dt = time.perf_counter() - t
+    keys = ("tiles", "images_used", "seconds_color", "seconds_mosaic", "max_triangles_per_tile", "margin_cells")
+    rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(json.dumps({"seconds": dt, "cells": r.grid.rows * r.grid.cols, "textured": r.stats["cells_textured"],
-                      "bands": r.stats["bands"], "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
-                      "stats": {k: r.stats[k] for k in ("tiles", "images_used", "seconds_color", "seconds_mosaic",
-                                                        "max_triangles_per_tile", "margin_cells")}}))
+                      "bands": r.stats["bands"], "maxrss_mb": rss, "stats": {k: r.stats[k] for k in keys}}))
     """
 )
 
@@ -114,7 +114,6 @@ def run_json(cmd: list[str], env=None) -> dict:
 
 
 def quality(scene, path, grid, truth, buildings, seen) -> dict:
-    from truortho.core.ortho import evaluate as ev
     from truortho.core.rasterio_io import read_raster
 
     a, _, _ = read_raster(path, band=None)
@@ -128,8 +127,12 @@ def _quality(rgb, valid, truth, buildings, seen) -> dict:
 
     gh = ev.ghosting(rgb, truth, valid, buildings, 2.0)
     sh = ev.phase_shift(rgb.astype(float).mean(-1) / 255, truth.astype(float).mean(-1) / 255, valid)
-    return {"ghosting": round(gh["share"], 5), "shift_gsd": round(sh["median"], 3),
-            "coverage": round(ev.coverage(valid, seen), 5), "mean_dE": round(ev.mean_delta_e(rgb, truth, valid), 2)}
+    return {
+        "ghosting": round(gh["share"], 5),
+        "shift_gsd": round(sh["median"], 3),
+        "coverage": round(ev.coverage(valid, seen), 5),
+        "mean_dE": round(ev.mean_delta_e(rgb, truth, valid), 2),
+    }
 
 
 def orthority_nearest_nadir(scene, out_dir, grid):
@@ -140,15 +143,29 @@ def orthority_nearest_nadir(scene, out_dir, grid):
     rgb = np.zeros(grid.shape + (3,), np.uint8)
     best = np.full(grid.shape, np.inf)
     X, Y = grid.centres()
-    for k, im in enumerate(scene.orientation.images[: scene.n_nadir]):
+    for im in scene.orientation.images[: scene.n_nadir]:
         p = os.path.join(out_dir, im.name[:-4] + ".tif")
         with rasterio.open(p) as ds:
             dst = np.zeros((3,) + grid.shape, np.uint8)
-            reproject(ds.read([1, 2, 3]), dst, src_transform=ds.transform, src_crs=ds.crs,
-                      dst_transform=grid.transform, dst_crs=ds.crs, resampling=Resampling.nearest)
+            reproject(
+                ds.read([1, 2, 3]),
+                dst,
+                src_transform=ds.transform,
+                src_crs=ds.crs,
+                dst_transform=grid.transform,
+                dst_crs=ds.crs,
+                resampling=Resampling.nearest,
+            )
             m = np.zeros(grid.shape, np.uint8)
-            reproject(ds.dataset_mask(), m, src_transform=ds.transform, src_crs=ds.crs,
-                      dst_transform=grid.transform, dst_crs=ds.crs, resampling=Resampling.nearest)
+            reproject(
+                ds.dataset_mask(),
+                m,
+                src_transform=ds.transform,
+                src_crs=ds.crs,
+                dst_transform=grid.transform,
+                dst_crs=ds.crs,
+                resampling=Resampling.nearest,
+            )
         c = im.C + scene.offset
         d = np.hypot(X - c[0], Y - c[1])
         take = (m > 0) & (d < best)
@@ -178,37 +195,59 @@ def main() -> int:
     t = time.perf_counter()
     scene = make_scene(cfg)
     scene.write(work)
-    write_orientation(Orientation.load(os.path.join(work, "orientation.json")), "opk", os.path.join(work, "opk"))
+    write_orientation(
+        Orientation.load(os.path.join(work, "orientation.json")), "opk", os.path.join(work, "opk")
+    )
     res = cfg.gsd
     dsm, gt = scene.dsm(res)
     grid = RasterGrid.from_geotransform(gt, dsm.shape[0], dsm.shape[1], cfg.crs)
     truth, _ = scene.orthophoto(res)
     buildings = ev.building_mask(scene, grid)
     seen = ev.truth_seen(scene, grid, 45.0)
-    print(f"scene: {len(scene.images)} images {w}x{h}, GSD {res} m, ortho {grid.cols}x{grid.rows} cells "
-          f"({time.perf_counter() - t:.0f} s to build)", flush=True)
+    print(
+        f"scene: {len(scene.images)} images {w}x{h}, GSD {res} m, ortho {grid.cols}x{grid.rows} cells "
+        f"({time.perf_counter() - t:.0f} s to build)",
+        flush=True,
+    )
 
     env = dict(os.environ)
-    results: dict = {"scene": {"images": len(scene.images), "image_size": [w, h], "gsd": res,
-                               "cells": grid.rows * grid.cols, "seed": args.seed}}
+    results: dict = {
+        "scene": {
+            "images": len(scene.images),
+            "image_size": [w, h],
+            "gsd": res,
+            "cells": grid.rows * grid.cols,
+            "seed": args.seed,
+        }
+    }
     py = sys.executable
-    ours = run_json([py, "-P", "-c", OURS, work, os.path.join(work, "ours.tif"), str(res), str(args.tile), "1",
-                     "1"], env)
-    conv = run_json([py, "-P", "-c", OURS, work, os.path.join(work, "conv.tif"), str(res), str(args.tile), "0",
-                     "0"], env)
+    ours = run_json(
+        [py, "-P", "-c", OURS, work, os.path.join(work, "ours.tif"), str(res), str(args.tile), "1", "1"], env
+    )
+    conv = run_json(
+        [py, "-P", "-c", OURS, work, os.path.join(work, "conv.tif"), str(res), str(args.tile), "0", "0"], env
+    )
     ours_mpx = ours["cells"] * ours["bands"] / ours["seconds"] / 1e6
-    results["ours"] = {**ours, "mpix_per_s": round(ours_mpx, 3),
-                       "quality": quality(scene, os.path.join(work, "ours.tif"), grid, truth, buildings, seen)}
-    results["ours_conventional"] = {**conv, "mpix_per_s": round(conv["cells"] * conv["bands"] / conv["seconds"] / 1e6, 3),
-                                    "quality": quality(scene, os.path.join(work, "conv.tif"), grid, truth, buildings,
-                                                       seen)}
+    results["ours"] = {
+        **ours,
+        "mpix_per_s": round(ours_mpx, 3),
+        "quality": quality(scene, os.path.join(work, "ours.tif"), grid, truth, buildings, seen),
+    }
+    results["ours_conventional"] = {
+        **conv,
+        "mpix_per_s": round(conv["cells"] * conv["bands"] / conv["seconds"] / 1e6, 3),
+        "quality": quality(scene, os.path.join(work, "conv.tif"), grid, truth, buildings, seen),
+    }
     if not args.no_orthority:
         opy = ensure_orthority()
         oo = run_json([opy, "-c", ORTHORITY, work, os.path.join(work, "orthority"), str(res)])
         rgb, valid = orthority_nearest_nadir(scene, os.path.join(work, "orthority"), grid)
-        results["orthority"] = {**oo, "mpix_per_s": round(oo["pixels"] / oo["seconds"] / 1e6, 3),
-                                "valid_mpix_per_s": round(oo["valid_pixels"] / oo["seconds"] / 1e6, 3),
-                                "quality_nearest_nadir_mosaic": _quality(rgb, valid, truth, buildings, seen)}
+        results["orthority"] = {
+            **oo,
+            "mpix_per_s": round(oo["pixels"] / oo["seconds"] / 1e6, 3),
+            "valid_mpix_per_s": round(oo["valid_pixels"] / oo["seconds"] / 1e6, 3),
+            "quality_nearest_nadir_mosaic": _quality(rgb, valid, truth, buildings, seen),
+        }
         results["ratio_output_rate"] = round(ours_mpx / results["orthority"]["mpix_per_s"], 3)
         results["ratio_output_rate_valid"] = round(ours_mpx / results["orthority"]["valid_mpix_per_s"], 3)
         results["ratio_time_for_the_block"] = round(oo["seconds"] / ours["seconds"], 3)
@@ -220,12 +259,16 @@ def main() -> int:
             continue
         r = results[key]
         q = r.get("quality") or r.get("quality_nearest_nadir_mosaic")
-        print(f"| {key} | {r['seconds']:.2f} | {r['mpix_per_s']:.2f} | {r['maxrss_mb']:.0f} | {q['ghosting']:.4f} | "
-              f"{q['shift_gsd']:.3f} | {q['coverage']:.4f} | {q['mean_dE']:.2f} |")
+        print(
+            f"| {key} | {r['seconds']:.2f} | {r['mpix_per_s']:.2f} | {r['maxrss_mb']:.0f} | "
+            f"{q['ghosting']:.4f} | {q['shift_gsd']:.3f} | {q['coverage']:.4f} | {q['mean_dE']:.2f} |"
+        )
     if "orthority" in results:
-        print(f"\nratio output rate ours / Orthority: {results['ratio_output_rate']} (all written pixels), "
-              f"{results['ratio_output_rate_valid']} (valid pixels only); Orthority time / ours for the whole "
-              f"block: {results['ratio_time_for_the_block']}")
+        print(
+            f"\nratio output rate ours / Orthority: {results['ratio_output_rate']} (all written pixels), "
+            f"{results['ratio_output_rate_valid']} (valid pixels only); Orthority time / ours for the whole "
+            f"block: {results['ratio_time_for_the_block']}"
+        )
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
     with open(os.path.join(HERE, "results", "trueortho.json"), "w") as fh:
         json.dump(results, fh, indent=1)

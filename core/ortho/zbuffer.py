@@ -120,8 +120,18 @@ def dsm_triangles(heights, x_min: float, y_max: float, res: float, include=None,
     valid = np.isfinite(h)
     inc = valid if include is None else (np.asarray(include, dtype=bool) & valid)
     with np.errstate(invalid="ignore"):
-        step_e = valid[:, :-1] & valid[:, 1:] & (inc[:, :-1] | inc[:, 1:]) & (np.abs(h[:, :-1] - h[:, 1:]) > wall_min)
-        step_s = valid[:-1, :] & valid[1:, :] & (inc[:-1, :] | inc[1:, :]) & (np.abs(h[:-1, :] - h[1:, :]) > wall_min)
+        step_e = (
+            valid[:, :-1]
+            & valid[:, 1:]
+            & (inc[:, :-1] | inc[:, 1:])
+            & (np.abs(h[:, :-1] - h[:, 1:]) > wall_min)
+        )
+        step_s = (
+            valid[:-1, :]
+            & valid[1:, :]
+            & (inc[:-1, :] | inc[1:, :])
+            & (np.abs(h[:-1, :] - h[1:, :]) > wall_min)
+        )
     # only the cells some face uses get vertices
     need = inc.copy()
     need[:, :-1] |= step_e
