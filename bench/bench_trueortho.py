@@ -60,10 +60,12 @@ OURS = textwrap.dedent(
     r = true_ortho(folder + "/orientation.json", folder + "/dsm.tif", out, out[:-4] + "_idx.tif",
                    out[:-4] + "_occ.tif", config=cfg)
     dt = time.perf_counter() - t
-    keys = ("tiles", "images_used", "seconds_color", "seconds_mosaic", "max_triangles_per_tile", "margin_cells")
+    keys = ("tiles", "images_used", "seconds_color", "seconds_mosaic", "max_triangles_per_tile",
+            "margin_cells")
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-    print(json.dumps({"seconds": dt, "cells": r.grid.rows * r.grid.cols, "textured": r.stats["cells_textured"],
-                      "bands": r.stats["bands"], "maxrss_mb": rss, "stats": {k: r.stats[k] for k in keys}}))
+    print(json.dumps({"seconds": dt, "cells": r.grid.rows * r.grid.cols,
+                      "textured": r.stats["cells_textured"], "bands": r.stats["bands"], "maxrss_mb": rss,
+                      "stats": {k: r.stats[k] for k in keys}}))
     """
 )
 
