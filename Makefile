@@ -36,5 +36,6 @@ bench: setup
 	$(ENV) $(PY) -m pip install -q -r requirements-bench.txt -c constraints.txt
 	@for f in bench/bench_$(BENCH).py; do echo "== $$f"; $(ENV) $(PY) -P $$f || exit 1; done
 
-zip:
-	@echo "zip: TODO (plugin zip for plugins.qgis.org)"; exit 1
+# The installable plugin zip (truortho/ at its root; no tests, benchmarks or data beyond the demo sample).
+zip: setup
+	$(ENV) $(PY) -P scripts/build_zip.py --output dist

@@ -11,8 +11,9 @@ older file of the same name before the new one is ready).
 * :func:`write_raster`: a whole array at once (through :class:`RasterWriter`).
 * :func:`read_raster`, :func:`raster_grid`, :func:`read_onto_grid`: read a raster
   as stored, or resampled/reprojected onto a :class:`~.grid.RasterGrid`.
-* :func:`write_point_cloud`: LAS 1.4 / LAZ with RGB, extra dimensions and the
-  CRS as WKT.
+* :func:`write_point_cloud` and :class:`PointCloudWriter` (in chunks): LAS 1.4 /
+  LAZ with RGB, extra dimensions, extra VLRs and the CRS as WKT;
+  :func:`read_point_cloud_arrays` reads them back.
 
 GDAL-linked packages come from the same distribution as QGIS (README,
 "Dependency policy"); rasterio is imported lazily.
@@ -367,7 +368,8 @@ def read_onto_grid(
 ) -> np.ndarray:
     """Resample (and reproject when the CRSs differ) one band onto ``grid``.
 
-    Cells outside the raster or on its nodata become NaN (float output).
+    Cells outside the raster or on its nodata become NaN (float output). Only the
+    window of the raster that covers ``grid`` (plus a margin) is read.
 
     Raises
     ------
@@ -385,10 +387,13 @@ def read_onto_grid(
         if not 1 <= band <= ds.count:
             raise InputError(f"{path}: band {band} does not exist (the raster has {ds.count} band(s))")
         try:
+            src, src_transform = _source_window(ds, grid, band, dtype)
+            if src is None:
+                return dst
             reproject(
-                source=ds.read(band).astype(dtype),
+                source=src,
                 destination=dst,
-                src_transform=ds.transform,
+                src_transform=src_transform,
                 src_crs=ds.crs,
                 src_nodata=ds.nodata,
                 dst_transform=grid.transform,
@@ -403,7 +408,172 @@ def read_onto_grid(
     return dst
 
 
+def _source_window(ds, grid: RasterGrid, band: int, dtype):
+    """The part of band ``band`` of ``ds`` covering ``grid`` (+ 3 pixels): ``(array, transform)``.
+
+    ``(None, None)`` when the grid lies entirely outside the raster.
+    """
+    from rasterio.warp import transform_bounds
+    from rasterio.windows import Window, from_bounds
+
+    x0, y0, x1, y1 = grid.extent
+    dst_crs = _crs_object(grid.crs)
+    if ds.crs is not None and dst_crs is not None and ds.crs != dst_crs:
+        x0, y0, x1, y1 = transform_bounds(dst_crs, ds.crs, x0, y0, x1, y1, densify_pts=21)
+    win = from_bounds(x0, y0, x1, y1, transform=ds.transform)
+    c0 = max(int(np.floor(win.col_off)) - 3, 0)
+    r0 = max(int(np.floor(win.row_off)) - 3, 0)
+    c1 = min(int(np.ceil(win.col_off + win.width)) + 3, ds.width)
+    r1 = min(int(np.ceil(win.row_off + win.height)) + 3, ds.height)
+    if c1 <= c0 or r1 <= r0:
+        return None, None
+    w = Window(c0, r0, c1 - c0, r1 - r0)
+    return ds.read(band, window=w).astype(dtype), ds.window_transform(w)
+
+
 # ------------------------------------------------------------------ point clouds
+
+
+class PointCloudWriter:
+    """A LAS 1.4 / LAZ file written in chunks, renamed into place on success.
+
+    Point format 7 (RGB) or 6, 16-bit colours (8-bit input is scaled by 257),
+    extra dimensions (LAS extra bytes) and the CRS as a WKT VLR (global
+    encoding WKT bit set). Header bounds and counts are updated on closing.
+    Use as a context manager::
+
+        with PointCloudWriter(path, crs, rgb=True, extra={"confidence": "f4"},
+                              offsets=(x0, y0, 0.0)) as w:
+            for chunk in chunks:
+                w.write(xyz, rgb, confidence=conf)
+
+    Parameters
+    ----------
+    path : str or os.PathLike
+        ``.las`` or ``.laz`` (compressed, LASzip via lazrs).
+    crs : str, optional
+    rgb : bool
+        Whether points carry colours (point format 7, else 6).
+    extra : dict name -> numpy dtype, optional
+        Extra dimensions, in order.
+    offsets : (3,) float, optional
+        Coordinate offsets of the integer storage (default: from the first chunk).
+    scale : float
+        Coordinate resolution, metres.
+    vlrs : sequence of (user_id, record_id, description, bytes), optional
+        Additional variable-length records (e.g. TruOrtho's reference-system table).
+    legacy : bool
+        Write LAS point format 2 (RGB) or 0 instead of 7/6: the formats the LASzip
+        decoder of older readers (QGIS 3.22's EPT provider) decompresses.
+    """
+
+    def __init__(self, path, crs: str | None = None, rgb: bool = False,
+                 extra: dict[str, Any] | None = None, offsets=None, scale: float = 0.001,
+                 vlrs: Sequence[tuple[str, int, str, bytes]] = (), legacy: bool = False) -> None:
+        import laspy
+
+        p = Path(os.fspath(path))
+        if p.suffix.lower() not in POINT_CLOUD_EXTENSIONS:
+            raise InputError(f"point cloud {str(p)!r}: expected a file name ending in .las or .laz")
+        if not (np.isfinite(scale) and scale > 0):
+            raise InputError(f"{p}: coordinate scale must be positive, got {scale!r}")
+        self.path = p
+        self.rgb = bool(rgb)
+        self.extra = {str(k): np.dtype(v) for k, v in (extra or {}).items()}
+        fmt = (2 if rgb else 0) if legacy else (7 if rgb else 6)
+        header = laspy.LasHeader(point_format=fmt, version="1.4")
+        header.scales = np.array([scale, scale, scale])
+        for name, dt in self.extra.items():
+            header.add_extra_dim(laspy.ExtraBytesParams(name=name, type=dt))
+        if crs is not None:
+            from .geometry.frame import parse_crs
+
+            header.add_crs(parse_crs(crs))
+        for user_id, record_id, description, data in vlrs:
+            header.vlrs.append(laspy.VLR(user_id=user_id, record_id=record_id, description=description,
+                                         record_data=data))
+        self.header = header
+        self._offsets = None if offsets is None else np.asarray(offsets, dtype=np.float64).reshape(3)
+        self._tmp: Path | None = None
+        self._writer: Any = None
+        self.count = 0
+
+    def __enter__(self) -> PointCloudWriter:
+        self._tmp = temporary_path(self.path)
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        return self
+
+    def _open(self, first_xyz: np.ndarray) -> None:
+        import laspy
+
+        if self._offsets is None:
+            self._offsets = np.floor(first_xyz.min(axis=0)) if len(first_xyz) else np.zeros(3)
+        self.header.offsets = self._offsets
+        try:
+            self._writer = laspy.open(str(self._tmp), mode="w", header=self.header,
+                                      do_compress=self.path.suffix.lower() == ".laz")
+        except Exception as exc:
+            raise FormatError(self.path, f"cannot create the point cloud ({exc})") from None
+
+    def write(self, xyz: np.ndarray, rgb: np.ndarray | None = None, **extra: np.ndarray) -> None:
+        """Append points: ``xyz`` (N, 3) world, ``rgb`` (N, 3) uint8/uint16, extra dims (N,)."""
+        import laspy
+
+        if self._tmp is None:
+            raise InputError(f"{self.path}: PointCloudWriter.write outside its 'with' block")
+        pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+        if not np.all(np.isfinite(pts)):
+            raise InputError(f"{self.path}: point coordinates must be finite")
+        n = len(pts)
+        if self._writer is None:
+            self._open(pts)
+        if n == 0:
+            return
+        rec = laspy.ScaleAwarePointRecord.zeros(n, header=self.header)
+        rec.x, rec.y, rec.z = pts[:, 0], pts[:, 1], pts[:, 2]
+        if self.rgb:
+            if rgb is None:
+                raise InputError(f"{self.path}: this point cloud has colours; rgb is required")
+            c = np.asarray(rgb).reshape(-1, 3)
+            if len(c) != n:
+                raise InputError(f"{self.path}: {len(c)} colours for {n} points")
+            c16 = c.astype(np.uint16) * 257 if c.dtype == np.uint8 else c.astype(np.uint16)
+            rec.red, rec.green, rec.blue = c16[:, 0], c16[:, 1], c16[:, 2]
+        for name in self.extra:
+            if name not in extra:
+                raise InputError(f"{self.path}: extra dimension {name!r} missing from write()")
+        for name, values in extra.items():
+            if name not in self.extra:
+                raise InputError(f"{self.path}: unknown extra dimension {name!r}")
+            v = np.asarray(values)
+            if v.shape != (n,):
+                raise InputError(
+                    f"{self.path}: extra dimension {name!r} has shape {v.shape}, expected ({n},)"
+                )
+            rec[name] = v.astype(self.extra[name])
+        try:
+            self._writer.write_points(rec)
+        except Exception as exc:
+            raise FormatError(self.path, f"cannot write the point cloud ({exc})") from None
+        self.count += n
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        writer, self._writer = self._writer, None
+        tmp, self._tmp = self._tmp, None
+        try:
+            if exc_type is None and tmp is not None:
+                if writer is None:
+                    self._open(np.zeros((0, 3)))
+                    writer, self._writer = self._writer, None
+                writer.close()
+                os.replace(tmp, self.path)
+            elif writer is not None:
+                with contextlib.suppress(Exception):
+                    writer.close()
+        finally:
+            if tmp is not None:
+                with contextlib.suppress(FileNotFoundError):
+                    tmp.unlink()
 
 
 def write_point_cloud(
@@ -421,51 +591,53 @@ def write_point_cloud(
     xyz : (N, 3) float64
         World coordinates (CRS units).
     rgb : (N, 3) uint8 or uint16, optional
-        Colours; 8-bit values are scaled to LAS's 16-bit range (× 257).
+        Colours; 8-bit values are scaled to LAS's 16-bit range (x 257).
     crs : str, optional
         Written as a WKT CRS VLR (LAS 1.4 global encoding WKT bit set).
     extra : dict name -> (N,) array
         Extra dimensions (float32, uint8, uint16, int32 ...), e.g. ``confidence``.
     scale : float
         Coordinate resolution (metres).
+
+    See :class:`PointCloudWriter` for writing in chunks.
+    """
+    extra = extra or {}
+    pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
+    with PointCloudWriter(path, crs, rgb is not None, {k: np.asarray(v).dtype for k, v in extra.items()},
+                          scale=scale) as w:
+        w.write(pts, rgb, **extra)
+    return Path(os.fspath(path))
+
+
+def read_point_cloud_arrays(path) -> dict[str, Any]:
+    """Read a LAS/LAZ file: ``{"xyz", "rgb" (uint16 or None), "extra": {name: array}, "crs", "vlrs"}``.
+
+    ``crs`` is the WKT of the file's CRS (None when it has none); ``vlrs`` maps
+    ``(user_id, record_id)`` to the record bytes of the other VLRs.
     """
     import laspy
 
-    p = Path(os.fspath(path))
-    if p.suffix.lower() not in POINT_CLOUD_EXTENSIONS:
-        raise InputError(f"point cloud {str(p)!r}: expected a file name ending in .las or .laz")
-    pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
-    if not np.all(np.isfinite(pts)):
-        raise InputError(f"{p}: point coordinates must be finite")
-    n = len(pts)
-    header = laspy.LasHeader(point_format=7 if rgb is not None else 6, version="1.4")
-    header.scales = np.array([scale, scale, scale])
-    header.offsets = np.floor(pts.min(axis=0)) if n else np.zeros(3)
-    extra = extra or {}
-    for name, values in extra.items():
-        v = np.asarray(values)
-        if v.shape != (n,):
-            raise InputError(f"{p}: extra dimension {name!r} has shape {v.shape}, expected ({n},)")
-        header.add_extra_dim(laspy.ExtraBytesParams(name=name, type=v.dtype))
-    if crs is not None:
-        from .geometry.frame import parse_crs
-
-        header.add_crs(parse_crs(crs))
-    las = laspy.LasData(header)
-    las.x = pts[:, 0]
-    las.y = pts[:, 1]
-    las.z = pts[:, 2]
-    if rgb is not None:
-        c = np.asarray(rgb).reshape(-1, 3)
-        if len(c) != n:
-            raise InputError(f"{p}: {len(c)} colours for {n} points")
-        c16 = c.astype(np.uint16) * 257 if c.dtype == np.uint8 else c.astype(np.uint16)
-        las.red, las.green, las.blue = c16[:, 0], c16[:, 1], c16[:, 2]
-    for name, values in extra.items():
-        las[name] = np.asarray(values)
-    with atomic_output(p) as tmp:
-        try:
-            las.write(str(tmp), do_compress=p.suffix.lower() == ".laz")
-        except Exception as exc:
-            raise FormatError(p, f"cannot write the point cloud ({exc})") from None
-    return p
+    p = os.fspath(path)
+    if not os.path.isfile(p):
+        raise MissingFileError(p, "point cloud file not found")
+    try:
+        las = laspy.read(p)
+    except Exception as exc:
+        raise FormatError(p, f"not a readable LAS/LAZ file ({exc})") from None
+    xyz = np.column_stack([np.asarray(las.x), np.asarray(las.y), np.asarray(las.z)])
+    dims = set(las.point_format.dimension_names)
+    rgb = None
+    if {"red", "green", "blue"} <= dims:
+        rgb = np.column_stack([np.asarray(las.red), np.asarray(las.green), np.asarray(las.blue)])
+    extra = {name: np.asarray(las[name]) for name in las.point_format.extra_dimension_names}
+    crs = None
+    try:
+        c = las.header.parse_crs()
+        crs = c.to_wkt() if c is not None else None
+    except Exception:
+        crs = None
+    vlrs = {}
+    for v in las.header.vlrs:
+        if hasattr(v, "record_data") and isinstance(getattr(v, "record_data", None), bytes | bytearray):
+            vlrs[(v.user_id, v.record_id)] = bytes(v.record_data)
+    return {"xyz": xyz, "rgb": rgb, "extra": extra, "crs": crs, "vlrs": vlrs}

@@ -1,32 +1,134 @@
-"""The object QGIS creates through ``classFactory``: registers the Processing provider."""
+"""The object QGIS creates through ``classFactory``: provider, translations, menu and toolbar."""
 
 from __future__ import annotations
 
-from qgis.core import QgsApplication
+import os
 
-from ..processing.provider import TruOrthoProvider
+from qgis.core import QgsApplication, QgsSettings
+from qgis.PyQt.QtCore import QCoreApplication, QTranslator
+from qgis.PyQt.QtGui import QIcon
+from qgis.PyQt.QtWidgets import QAction
+
+from ..processing.i18n import tr
+from ..processing.provider import ICON_PATH, PLUGIN_DIR, TruOrthoProvider
+
+MENU = "&TruOrtho"
+#: Menu entries: (algorithm id, label). The first one is also the toolbar button.
+ENTRIES = (
+    ("truortho:pipeline", "Photos to true orthophoto (whole pipeline)…"),
+    ("truortho:orientimages", "Orient images…"),
+    ("truortho:osgm", "Dense matching (OSGM)…"),
+    ("truortho:dsmfilter", "Filter DSM…"),
+    ("truortho:mesh", "DSM to mesh…"),
+    ("truortho:trueortho", "True orthophoto…"),
+)
+
+
+def user_locale() -> str:
+    """QGIS's user interface language (``de``, ``fr_CA``...), as QGIS itself decides it."""
+    settings = QgsSettings()
+    if settings.value("locale/overrideFlag", False, type=bool):
+        loc = settings.value("locale/userLocale", "") or ""
+    else:
+        from qgis.PyQt.QtCore import QLocale
+
+        loc = QLocale.system().name()
+    return str(loc or "en")
+
+
+def translation_file(locale: str) -> str | None:
+    """``i18n/truortho_<lang>.qm`` for a locale (``de_AT`` falls back to ``de``), or None."""
+    folder = os.path.join(PLUGIN_DIR, "i18n")
+    for tag in (locale, locale.split("_")[0]):
+        path = os.path.join(folder, f"truortho_{tag}.qm")
+        if os.path.isfile(path):
+            return path
+    return None
 
 
 class TruOrthoPlugin:
-    """Registers :class:`TruOrthoProvider` with the Processing registry.
+    """Registers :class:`TruOrthoProvider`, installs the translation, adds menu and toolbar entries.
 
     ``initProcessing`` is what ``qgis_process`` calls (hasProcessingProvider=yes);
-    the desktop calls ``initGui``. Both are idempotent.
+    the desktop calls ``initGui``. Both are idempotent; ``unload`` undoes both.
     """
 
     def __init__(self, iface) -> None:
         self.iface = iface
         self.provider: TruOrthoProvider | None = None
+        self.translator: QTranslator | None = None
+        self.actions: list[QAction] = []
+        self.toolbar = None
+        self.install_translator()
 
+    # ------------------------------------------------------------ translations
+    def install_translator(self, locale: str | None = None) -> bool:
+        """Load ``i18n/truortho_<lang>.qm`` for the QGIS locale (or ``locale``); True when loaded."""
+        path = translation_file(locale or user_locale())
+        if path is None:
+            return False
+        translator = QTranslator()
+        if not translator.load(path):
+            return False
+        if self.translator is not None:
+            QCoreApplication.removeTranslator(self.translator)
+        QCoreApplication.installTranslator(translator)
+        self.translator = translator
+        return True
+
+    # ------------------------------------------------------------ processing
     def initProcessing(self) -> None:  # noqa: N802 - QGIS API
         if self.provider is None:
-            self.provider = TruOrthoProvider()
-            QgsApplication.processingRegistry().addProvider(self.provider)
+            provider = TruOrthoProvider()
+            if QgsApplication.processingRegistry().addProvider(provider):
+                self.provider = provider
 
+    # ------------------------------------------------------------ GUI
     def initGui(self) -> None:  # noqa: N802 - QGIS API
         self.initProcessing()
+        if self.actions or self.iface is None:
+            return
+        icon = QIcon(ICON_PATH)
+        parent = self.iface.mainWindow()
+        self.toolbar = self.iface.addToolBar(tr("TruOrtho"))
+        self.toolbar.setObjectName("TruOrthoToolbar")
+        for alg_id, label in ENTRIES:
+            action = QAction(icon, tr(label), parent)
+            action.setObjectName(alg_id.replace(":", "_"))
+            action.setData(alg_id)
+            action.triggered.connect(lambda _checked=False, a=alg_id: self.open_dialog(a))
+            self.iface.addPluginToRasterMenu(tr(MENU), action)
+            self.actions.append(action)
+        self.toolbar.addAction(self.actions[0])
+
+    def open_dialog(self, alg_id: str):
+        """Open the Processing dialog of an algorithm (results load into the project as layers)."""
+        import processing
+
+        registry = QgsApplication.processingRegistry()
+        if registry.algorithmById(alg_id) is None:
+            self.iface.messageBar().pushWarning(
+                tr("TruOrtho"), tr("The algorithm {} is not available in this version.").format(alg_id)
+            )
+            return None
+        return processing.execAlgorithmDialog(alg_id, {})
 
     def unload(self) -> None:
+        self.unload_gui()
         if self.provider is not None:
             QgsApplication.processingRegistry().removeProvider(self.provider)
             self.provider = None
+        if self.translator is not None:
+            QCoreApplication.removeTranslator(self.translator)
+            self.translator = None
+
+    def unload_gui(self) -> None:
+        """Remove the menu entries and the toolbar (the provider stays)."""
+        for action in self.actions:
+            if self.iface is not None:
+                self.iface.removePluginRasterMenu(tr(MENU), action)
+            action.deleteLater()
+        self.actions = []
+        if self.toolbar is not None:
+            self.toolbar.deleteLater()
+            self.toolbar = None

@@ -108,7 +108,7 @@ def prepare_views(
     wall_min: float,
     discontinuity: float = 0.5,
     edge_shift: float = 0.75,
-    max_margin_cells: int = 4096,
+    max_margin_cells: int = 1024,
 ) -> ViewSetup:
     images = list(orientation.images)
     cams = [orientation.camera_of(im) for im in images]

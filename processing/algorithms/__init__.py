@@ -5,11 +5,14 @@ Add a new algorithm by importing its class here and appending it to the list.
 
 from __future__ import annotations
 
+from .dsmfilter import DsmFilterAlgorithm
 from .environment import EnvironmentAlgorithm
 from .exportorientation import ExportOrientationAlgorithm
 from .importgcps import ImportGcpsAlgorithm
 from .importorientation import ImportOrientationAlgorithm
+from .mesh import MeshAlgorithm
 from .orientimages import OrientImagesAlgorithm
+from .pointcloud import DsmToPointCloudAlgorithm, MergePointCloudsAlgorithm
 from .trueortho import TrueOrthoAlgorithm
 
 ALGORITHMS: list[type] = [
@@ -19,4 +22,8 @@ ALGORITHMS: list[type] = [
     ImportGcpsAlgorithm,
     OrientImagesAlgorithm,
     TrueOrthoAlgorithm,
+    DsmFilterAlgorithm,
+    MeshAlgorithm,
+    DsmToPointCloudAlgorithm,
+    MergePointCloudsAlgorithm,
 ]

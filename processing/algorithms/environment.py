@@ -45,6 +45,7 @@ def collect_versions() -> dict[str, str | None]:
     """Versions of everything TruOrtho depends on (None when not importable)."""
     return {
         "truortho": _plugin_version(),
+        "truortho_path": _plugin_dir(),
         "qgis": Qgis.version(),
         "qgis_gdal": qgis_gdal_version(),
         "python": platform.python_version(),
@@ -60,6 +61,12 @@ def collect_versions() -> dict[str, str | None]:
         "shapely": _module_version("shapely"),
         "laspy": _module_version("laspy"),
     }
+
+
+def _plugin_dir() -> str:
+    from ..provider import PLUGIN_DIR
+
+    return PLUGIN_DIR
 
 
 def _plugin_version() -> str:

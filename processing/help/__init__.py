@@ -148,7 +148,118 @@ HELP: dict[str, dict] = {
             "image, cells, area).",
         },
     },
-
+    "dsmfilter": {
+        "summary": (
+            "Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the "
+            "cells of blurred height steps to the nearer side, removes outliers (cells that depart from the "
+            "confidence-weighted median of their window by more than the threshold and have too few "
+            "neighbours at their height, so roof edges and corners survive), fills holes up to a maximum "
+            "width by harmonic interpolation (holes at the foot of walls from the ground side only; wider "
+            "holes stay nodata and are reported), and optionally smooths planar surfaces without blurring "
+            "their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the "
+            "normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the "
+            "statistics (removed outliers, filled cells, remaining holes) are returned and logged."
+        ),
+        "parameters": {
+            "INPUT": "Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.",
+            "CONFIDENCE": "Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum "
+            "confidence are removed, less confident cells must agree better with their neighbours, and the "
+            "median is weighted by confidence.",
+            "OUTLIER_THRESHOLD": "Largest departure from the neighbourhood median, metres (empty: 4 x the "
+            "resolution).",
+            "OUTLIER_WINDOW": "Side of the median window in cells (odd); a second pass uses twice the "
+            "window.",
+            "MIN_SUPPORT": "Neighbours within the threshold of a cell's height that keep it although it "
+            "departs from the median (edges, corners, thin structures).",
+            "MIN_CONFIDENCE": "With a confidence raster: cells below this confidence are removed.",
+            "MAX_HOLE": "Largest hole width (metres) that is interpolated; 0 fills nothing.",
+            "STEP": "Height difference between two surfaces (a wall), metres: hole boundary cells that much "
+            "above nearby boundary cells are not interpolated from.",
+            "SHARPEN": "Snap the cells of blurred height steps (between the two levels of their 5 x 5 "
+            "window) to the nearer level.",
+            "SMOOTH": "Replace cells by a local plane fitted to the neighbours at their height (flat and "
+            "pitched roofs, streets); steps stay sharp.",
+            "SMOOTH_RADIUS": "Radius of the smoothing neighbourhood, cells.",
+            "SMOOTH_TOLERANCE": "Neighbours within this height of a cell belong to its surface, metres "
+            "(empty: 2.5 x the resolution).",
+            "DTM_RESOLUTION": "Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); "
+            "the DTM is written on the DSM grid.",
+            "MAX_WINDOW": "Largest opening radius of the ground filter, metres: more than half the width of "
+            "the largest building.",
+            "SLOPE": "Terrain slope (rise over run) the ground filter keeps as ground.",
+            "OUTPUT": "Filtered DSM (GeoTIFF, float32).",
+            "DTM": "Optional terrain model (GeoTIFF, float32, DSM grid).",
+            "NDSM": "Optional normalised DSM: DSM minus DTM, heights above the terrain.",
+            "STATISTICS": "JSON: the filter statistics (and the ground filter's).",
+            "OUTLIERS_REMOVED": "Cells removed as outliers or for low confidence.",
+            "CELLS_FILLED": "Hole cells interpolated.",
+            "HOLES_REMAINING": "Holes wider than MAX_HOLE, left as nodata.",
+        },
+    },
+    "mesh": {
+        "summary": (
+            "Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no "
+            "triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted "
+            "quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an "
+            "optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one "
+            "2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers "
+            "where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or "
+            "in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE."
+        ),
+        "parameters": {
+            "INPUT": "DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).",
+            "ORTHO": "Optional orthoimage (RGB) for the vertex colours of a DSM mesh.",
+            "MAX_ERROR": "Largest vertical difference between mesh and DSM at any cell centre, metres "
+            "(empty: half the DSM resolution).",
+            "MIN_STEP": "Smallest height difference between neighbouring cells that becomes a wall, metres.",
+            "MAX_SLOPE": "Steepest slope kept as sloping triangles, degrees: the step threshold is "
+            "max(MIN_STEP, resolution x tan(MAX_SLOPE)).",
+            "MAX_LEAF": "Largest block of cells one pair of triangles may cover (a power of two).",
+            "MAX_EDGE": "Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).",
+            "FRAME": "CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as "
+            "'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.",
+            "OUTPUT": "The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex "
+            "colours as 'v x y z r g b').",
+            "VERTICES": "Number of vertices.",
+            "FACES": "Number of triangles.",
+            "WALL_FACES": "Number of vertical wall triangles (DSM meshes).",
+        },
+    },
+    "dsmtopointcloud": {
+        "summary": (
+            "Exports a DSM as a point cloud, one point per valid cell centre, with colours from an "
+            "orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, "
+            "CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR "
+            "describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An "
+            "Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's "
+            "QGIS 3.22) open it as a point cloud layer (Layer > Add Layer > Point Cloud, choose ept.json)."
+        ),
+        "parameters": {
+            "INPUT": "DSM raster with a projected CRS.",
+            "ORTHO": "Optional orthoimage (RGB) for the point colours.",
+            "CONFIDENCE": "Optional confidence raster in [0, 1], stored as the 'confidence' dimension.",
+            "OUTPUT": "The point cloud (.laz compressed, or .las).",
+            "EPT": "Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.",
+            "EPT_JSON": "Path of the EPT dataset's ept.json.",
+            "POINTS": "Number of points written.",
+        },
+    },
+    "mergepointclouds": {
+        "summary": (
+            "Merges point clouds of several reference systems (e.g. the nadir and oblique systems of "
+            "dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it "
+            "get the index of their file) and confidence; optionally thins duplicates on a voxel grid, "
+            "keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS."
+        ),
+        "parameters": {
+            "INPUTS": "LAS/LAZ files in one CRS.",
+            "VOXEL": "Voxel size for thinning, metres (empty: keep every point).",
+            "OUTPUT": "The merged point cloud (.laz or .las).",
+            "EPT": "Optional folder for an EPT dataset of the merged cloud.",
+            "EPT_JSON": "Path of the EPT dataset's ept.json.",
+            "POINTS": "Number of points written.",
+        },
+    },
 }
 
 

@@ -1,0 +1,100 @@
+"""Desktop integration with pytest-qgis's iface: menu, toolbar, dialogs, translations, layer styles."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.qgis
+
+
+@pytest.fixture
+def gui_plugin(qgis_iface, truortho_plugin):
+    """The session's plugin object with its GUI started on pytest-qgis's iface."""
+    truortho_plugin.iface = qgis_iface
+    truortho_plugin.initGui()
+    yield truortho_plugin
+    truortho_plugin.unload_gui()
+    truortho_plugin.iface = None
+
+
+def test_menu_and_toolbar_entries(gui_plugin, qgis_iface):
+    from truortho.truortho_plugin.plugin import ENTRIES
+
+    assert [a.data() for a in gui_plugin.actions] == [e[0] for e in ENTRIES]
+    assert gui_plugin.toolbar.actions() == [gui_plugin.actions[0]]
+    assert all(not a.icon().isNull() for a in gui_plugin.actions)
+    gui_plugin.initGui()  # idempotent
+    assert len(gui_plugin.actions) == len(ENTRIES)
+
+
+def test_action_opens_the_processing_dialog(gui_plugin, monkeypatch):
+    import processing
+
+    opened = []
+    monkeypatch.setattr(processing, "execAlgorithmDialog", lambda alg, params: opened.append(alg) or {})
+    by_id = {a.data(): a for a in gui_plugin.actions}
+    by_id["truortho:orientimages"].trigger()
+    assert opened == ["truortho:orientimages"]
+
+
+def test_unavailable_algorithm_warns_instead_of_failing(gui_plugin, qgis_iface, monkeypatch):
+    import processing
+
+    monkeypatch.setattr(processing, "execAlgorithmDialog", lambda *a: pytest.fail("dialog opened"))
+    assert gui_plugin.open_dialog("truortho:does_not_exist") is None
+
+
+def test_unload_removes_entries(gui_plugin):
+    from qgis.core import QgsApplication
+
+    gui_plugin.unload()
+    assert gui_plugin.actions == [] and gui_plugin.toolbar is None
+    assert QgsApplication.processingRegistry().providerById("truortho") is None
+    gui_plugin.initProcessing()
+    assert QgsApplication.processingRegistry().providerById("truortho") is not None
+
+
+@pytest.mark.parametrize(
+    "kind,renderer",
+    [("dsm", "hillshade"), ("confidence", "singlebandpseudocolor"), ("occlusion", "paletted")],
+)
+def test_single_band_styles(tmp_path, qgis_processing_ready, kind, renderer):
+    from qgis.core import QgsRasterLayer
+
+    from truortho.core.grid import RasterGrid
+    from truortho.core.rasterio_io import write_raster
+    from truortho.processing.styles import apply_style
+
+    g = RasterGrid(500000.0, 5600000.0, 1.0, 40, 50, "EPSG:32632")
+    data = (
+        np.indices(g.shape).sum(0).astype(np.float32) % 2
+        if kind == "occlusion"
+        else np.indices(g.shape)[0].astype(np.float32)
+    )
+    write_raster(
+        tmp_path / "a.tif",
+        data.astype(np.uint8) if kind == "occlusion" else data,
+        g,
+        nodata=255 if kind == "occlusion" else -9999.0,
+    )
+    layer = QgsRasterLayer(str(tmp_path / "a.tif"), "a")
+    assert apply_style(layer, kind)
+    assert layer.renderer().type() == renderer
+
+
+def test_ortho_style_uses_alpha(tmp_path, qgis_processing_ready):
+    from qgis.core import QgsRasterLayer
+
+    from truortho.core.grid import RasterGrid
+    from truortho.core.rasterio_io import write_raster
+    from truortho.processing.styles import apply_style
+
+    g = RasterGrid(500000.0, 5600000.0, 1.0, 40, 50, "EPSG:32632")
+    write_raster(tmp_path / "o.tif", np.full((4, 40, 50), 200, np.uint8), g, alpha=True)
+    layer = QgsRasterLayer(str(tmp_path / "o.tif"), "o")
+    assert apply_style(layer, "ortho")
+    assert layer.renderer().type() == "multibandcolor" and layer.renderer().alphaBand() == 4
+    grey = QgsRasterLayer(str(tmp_path / "o.tif"), "o")
+    with pytest.raises(ValueError):
+        apply_style(grey, "nonsense")
