@@ -12,6 +12,8 @@ nadir block + 4 obliques, per-image exposure differences):
   seams, feathering, colour correction), output at the nominal GSD onto the truth DSM
   (``dsm.tif``), in its own subprocess; the same call in *conventional* mode
   (``visibility=False``) for the quality comparison;
+* ``--surface PATH``: another DSM of the same scene (e.g. from ``truortho:osgm``) instead of the
+  truth DSM, for ours and Orthority alike; the quality is still measured against the truth;
 * **Orthority** (pip ``orthority``, installed into a throw-away virtual environment under
   ``$TMPDIR`` on first use, never into .venv): ``oty.Ortho.process`` of every image onto the same
   DSM at the same resolution, bilinear image and DEM interpolation, one ortho per image (what a
@@ -53,11 +55,12 @@ OURS = textwrap.dedent(
     from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho
     folder, out, res, tile, vis, warm = sys.argv[1], sys.argv[2], float(sys.argv[3]), int(sys.argv[4]), \\
         sys.argv[5] == "1", sys.argv[6] == "1"
-    cfg = TrueOrthoConfig(resolution=res, tile_size=tile, visibility=vis)
+    dsm, extent = sys.argv[7], tuple(float(v) for v in sys.argv[8].split(","))
+    cfg = TrueOrthoConfig(resolution=res, tile_size=tile, visibility=vis, extent=extent)
     if warm:
-        true_ortho(folder + "/orientation.json", folder + "/dsm.tif", out, config=cfg)
+        true_ortho(folder + "/orientation.json", dsm, out, config=cfg)
     t = time.perf_counter()
-    r = true_ortho(folder + "/orientation.json", folder + "/dsm.tif", out, out[:-4] + "_idx.tif",
+    r = true_ortho(folder + "/orientation.json", dsm, out, out[:-4] + "_idx.tif",
                    out[:-4] + "_occ.tif", config=cfg)
     dt = time.perf_counter() - t
     keys = ("tiles", "images_used", "seconds_color", "seconds_mosaic", "max_triangles_per_tile",
@@ -75,14 +78,14 @@ ORTHORITY = textwrap.dedent(
     import numpy as np
     import orthority as oty
     import rasterio
-    folder, out, res = sys.argv[1], sys.argv[2], float(sys.argv[3])
+    folder, out, res, dsm = sys.argv[1], sys.argv[2], float(sys.argv[3]), sys.argv[4]
     cams = oty.FrameCameras(folder + "/opk/interior.yaml", folder + "/opk/exterior.csv")
     files = sorted(glob.glob(folder + "/img_*.png"))
     os.makedirs(out, exist_ok=True)
     t = time.perf_counter()
     for f in files:
         cam = cams.get(f)
-        o = oty.Ortho(f, folder + "/dsm.tif", cam, crs=cams.crs)
+        o = oty.Ortho(f, dsm, cam, crs=cams.crs)
         o.process(os.path.join(out, os.path.basename(f)[:-4] + ".tif"), resolution=(res, res),
                   interp="bilinear", dem_interp="bilinear", overwrite=True)
     dt = time.perf_counter() - t
@@ -183,6 +186,7 @@ def main() -> int:
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--tile", type=int, default=512)
     ap.add_argument("--no-orthority", action="store_true")
+    ap.add_argument("--surface", help="another DSM of the same scene (e.g. OSGM's) instead of the truth DSM")
     args = ap.parse_args()
     w, h = (int(v) for v in args.size.split("x"))
 
@@ -223,12 +227,14 @@ def main() -> int:
         }
     }
     py = sys.executable
-    ours = run_json(
-        [py, "-P", "-c", OURS, work, os.path.join(work, "ours.tif"), str(res), str(args.tile), "1", "1"], env
-    )
-    conv = run_json(
-        [py, "-P", "-c", OURS, work, os.path.join(work, "conv.tif"), str(res), str(args.tile), "0", "0"], env
-    )
+    dsm_path = os.path.abspath(args.surface) if args.surface else os.path.join(work, "dsm.tif")
+    results["surface"] = args.surface or "truth DSM"
+    ext = ",".join(str(v) for v in grid.extent)
+    tile = str(args.tile)
+    ours = run_json([py, "-P", "-c", OURS, work, os.path.join(work, "ours.tif"), str(res), tile, "1", "1",
+                     dsm_path, ext], env)
+    conv = run_json([py, "-P", "-c", OURS, work, os.path.join(work, "conv.tif"), str(res), tile, "0", "0",
+                     dsm_path, ext], env)
     ours_mpx = ours["cells"] * ours["bands"] / ours["seconds"] / 1e6
     results["ours"] = {
         **ours,
@@ -242,7 +248,7 @@ def main() -> int:
     }
     if not args.no_orthority:
         opy = ensure_orthority()
-        oo = run_json([opy, "-c", ORTHORITY, work, os.path.join(work, "orthority"), str(res)])
+        oo = run_json([opy, "-c", ORTHORITY, work, os.path.join(work, "orthority"), str(res), dsm_path])
         rgb, valid = orthority_nearest_nadir(scene, os.path.join(work, "orthority"), grid)
         results["orthority"] = {
             **oo,
@@ -272,7 +278,8 @@ def main() -> int:
             f"block: {results['ratio_time_for_the_block']}"
         )
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
-    with open(os.path.join(HERE, "results", "trueortho.json"), "w") as fh:
+    name = "trueortho.json" if not args.surface else "trueortho_surface.json"
+    with open(os.path.join(HERE, "results", name), "w") as fh:
         json.dump(results, fh, indent=1)
     return 0
 
