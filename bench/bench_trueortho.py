@@ -64,7 +64,7 @@ OURS = textwrap.dedent(
                    out[:-4] + "_occ.tif", config=cfg)
     dt = time.perf_counter() - t
     keys = ("tiles", "images_used", "seconds_color", "seconds_mosaic", "max_triangles_per_tile",
-            "margin_cells")
+            "margin_cells", "cell_image_samples")
     rss = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(json.dumps({"seconds": dt, "cells": r.grid.rows * r.grid.cols,
                       "textured": r.stats["cells_textured"], "bands": r.stats["bands"], "maxrss_mb": rss,
@@ -259,6 +259,10 @@ def main() -> int:
         results["ratio_output_rate"] = round(ours_mpx / results["orthority"]["mpix_per_s"], 3)
         results["ratio_output_rate_valid"] = round(ours_mpx / results["orthority"]["valid_mpix_per_s"], 3)
         results["ratio_time_for_the_block"] = round(oo["seconds"] / ours["seconds"], 3)
+        # like with like: one Orthority ortho pixel with data = one (cell, image) sample of ours
+        ours_sps = ours["stats"]["cell_image_samples"] * ours["bands"] / ours["seconds"] / 1e6
+        results["ours"]["sample_mpix_per_s"] = round(ours_sps, 3)
+        results["ratio_sample_rate"] = round(ours_sps / results["orthority"]["valid_mpix_per_s"], 3)
 
     print("\n| run | s | Mpx/s | peak MB | ghosting | shift (GSD) | coverage | mean dE |")
     print("|---|---|---|---|---|---|---|---|")
@@ -275,7 +279,8 @@ def main() -> int:
         print(
             f"\nratio output rate ours / Orthority: {results['ratio_output_rate']} (all written pixels), "
             f"{results['ratio_output_rate_valid']} (valid pixels only); Orthority time / ours for the whole "
-            f"block: {results['ratio_time_for_the_block']}"
+            f"block: {results['ratio_time_for_the_block']}; (cell, image) samples per second of ours / "
+            f"Orthority's valid pixels per second: {results['ratio_sample_rate']}"
         )
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
     name = "trueortho.json" if not args.surface else "trueortho_surface.json"

@@ -369,7 +369,7 @@ def true_ortho(
     sub = steps[2]
     parts: dict[int, list] = {}
     counts = np.zeros(len(o.images), np.int64)
-    n_seen = n_valid = n_occl = 0
+    n_seen = n_valid = n_occl = n_samples = 0
     out_path = Path(os.fspath(output))
     names = [f"band {k + 1}" for k in range(bands)] + ["alpha"]
     amax = np.iinfo(dtype).max if dtype.kind in "ui" else 1.0
@@ -426,6 +426,9 @@ def true_ortho(
             check(progress)
             views = tile_views(setup, surf, grid, tile, to_local, workers)
             tri_max = max(tri_max, views.triangles)
+            if len(views.cands):
+                isl = tile.inner_slices
+                n_samples += int(views.usable[:, isl[0], isl[1]].sum())
             fixed = _fixed_labels(tile, done)
             m = mosaic_tile(views, store, correction, res, params, fixed)
             sl = tile.inner_slices
@@ -466,6 +469,7 @@ def true_ortho(
             "images_used": int(np.count_nonzero(counts)),
             "image_reads": store.reads,
             "max_triangles_per_tile": int(tri_max),
+            "cell_image_samples": n_samples,
             "seconds_total": round(time.perf_counter() - t_start, 3),
         }
     )

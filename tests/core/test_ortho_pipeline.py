@@ -260,14 +260,17 @@ def test_mesh_surface_gives_the_dsm_result(data, tmp_path, as_file):
     if as_file:  # a PLY in a local frame with offset and CRS comments, read by core/surface/meshio.py
         from truortho.core.surface.meshio import Mesh, write_mesh
 
-        mesh = write_mesh(tmp_path / "surface.ply", Mesh(tris.vertices, tris.faces, crs=scene.config.crs),
-                          frame="local")
+        mesh = write_mesh(
+            tmp_path / "surface.ply", Mesh(tris.vertices, tris.faces, crs=scene.config.crs), frame="local"
+        )
     ext = scene.extent_world()
     sub = (ext[0] + 20, ext[1] + 20, ext[0] + 80, ext[1] + 70)
     cfg = TrueOrthoConfig(extent=sub, resolution=data["res"], color_correction=False)
     f = data["folder"]
     rm = true_ortho(f / "orientation.json", mesh, tmp_path / "m.tif", tmp_path / "mi.tif", config=cfg)
-    rd = true_ortho(f / "orientation.json", f / "dsm.tif", tmp_path / "d.tif", tmp_path / "di.tif", config=cfg)
+    rd = true_ortho(
+        f / "orientation.json", f / "dsm.tif", tmp_path / "d.tif", tmp_path / "di.tif", config=cfg
+    )
     im_, _, _ = read_raster(rm.source_index)
     id_, _, _ = read_raster(rd.source_index)
     assert (im_ == id_).mean() > 0.95
