@@ -182,8 +182,10 @@ def _load_orientation(orientation) -> Orientation:
     raise InputError(f"ORIENTATION: expected an orientation file or object, got {type(orientation).__name__}")
 
 
-def _default_resolution(surface, orientation: Orientation) -> float:
-    if getattr(surface, "res", None):
+def _default_resolution(surface, orientation: Orientation, out_crs) -> float:
+    """The DSM's cell size when it is in the output CRS, else the median nadir GSD."""
+    same = surface.crs is None or out_crs is None or same_crs(surface.crs, out_crs)
+    if getattr(surface, "res", None) and same:
         return float(surface.res)
     lo, hi = surface.height_range()
     z = 0.5 * (lo + hi) - orientation.offset[2]
@@ -263,13 +265,13 @@ def true_ortho(
     to_local = PlanTransform(out_crs, o_crs, o.offset)
     # ---- grid and coverage of the surface
     s_bounds = transform_bounds(surf.bounds, surf.crs or out_crs, out_crs)
-    res = float(cfg.resolution) if cfg.resolution else _default_resolution(surf, o)
+    res = float(cfg.resolution) if cfg.resolution else _default_resolution(surf, o, out_crs)
     extent = tuple(float(v) for v in (cfg.extent or s_bounds))
     grid = RasterGrid.from_extent(extent, res, out_crs)
     gx0, gy0, gx1, gy1 = grid.extent
     tol = 0.5 * res + 1e-6 * max(abs(gx0), abs(gy1), 1.0)
     if surf.crs is not None and out_crs is not None and not same_crs(surf.crs, out_crs):
-        tol += 2.0 * (surf.res or res)
+        tol += 2.0 * res  # the surface's cells, reprojected, may end up to a cell inside
     if (
         gx0 < s_bounds[0] - tol
         or gy0 < s_bounds[1] - tol
