@@ -49,6 +49,7 @@ from .mosaic import ImageStore, MosaicParams, candidate_colours, mosaic_tile, to
 from .seams import dissolve, region_polygons
 from .surface import PlanTransform, open_surface, same_crs, transform_bounds
 from .views import prepare_views, tile_views
+from .zbuffer import occluder_wall_min
 
 
 @dataclass
@@ -85,8 +86,10 @@ class TrueOrthoConfig:
         inside their own side (0 = at the cell centre), so building outlines do
         not mix roof and ground colours.
     wall_min : float, optional
-        Height steps of the DSM below this (m) get no wall in the depth buffer;
-        default a quarter of the cell size.
+        Height steps of the DSM below this (m) get no wall in the depth buffer
+        (which holds only the DSM's walls, see :func:`~.zbuffer.dsm_triangles`);
+        default :func:`~.zbuffer.occluder_wall_min` (a quarter cell over
+        tan(MAX_VIEW_ANGLE); steps below twice that cannot hide a cell seen within that angle).
     zbuffer_oversample : float
         Depth-buffer pixels per output cell when the image pixel is finer than the cell.
     image_cache_mb : int
@@ -287,7 +290,9 @@ def true_ortho(
     to_local.xy(
         np.array([gx0, gx1, gx0, gx1, 0.5 * (gx0 + gx1)]), np.array([gy0, gy0, gy1, gy1, 0.5 * (gy0 + gy1)])
     )
-    wall_min = cfg.wall_min if cfg.wall_min is not None else 0.25 * res
+    wall_min = (
+        cfg.wall_min if cfg.wall_min is not None else occluder_wall_min(res, math.radians(cfg.max_view_angle))
+    )
     setup = prepare_views(
         o,
         surf,

@@ -287,17 +287,34 @@ class ArraySurface(DsmSurface):
 
 
 def grid_triangles(
-    grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform, wall_min: float
+    grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform, wall_min: float, ring: int = 2
 ) -> Triangles:
-    """Tops and walls of heights on an output-grid window, in the local frame."""
+    """Occluders of heights on an output-grid window, in the local frame.
+
+    The walls (steps above ``wall_min``) and the tops of the cells within
+    ``ring`` cells of such a step, rendered double-sided: enough for the
+    visibility of the DSM's own cells (:func:`~.zbuffer.dsm_triangles`), far
+    fewer triangles than every cell top.
+    """
+    from scipy.ndimage import binary_dilation
+
+    with np.errstate(invalid="ignore"):
+        step = np.zeros(heights.shape, bool)
+        de = np.abs(heights[:, 1:] - heights[:, :-1]) > wall_min
+        ds = np.abs(heights[1:, :] - heights[:-1, :]) > wall_min
+    step[:, 1:] |= de
+    step[:, :-1] |= de
+    step[1:, :] |= ds
+    step[:-1, :] |= ds
+    tops = binary_dilation(step, iterations=ring) if ring > 0 and step.any() else step
     if to_local.identity:
         o = to_local.offset
         return dsm_triangles(
-            heights - o[2], grid.x_min - o[0], grid.y_max - o[1], grid.res, include, wall_min
+            heights - o[2], grid.x_min - o[0], grid.y_max - o[1], grid.res, include, wall_min, tops
         )
-    tris = dsm_triangles(heights, grid.x_min, grid.y_max, grid.res, include, wall_min)
+    tris = dsm_triangles(heights, grid.x_min, grid.y_max, grid.res, include, wall_min, tops)
     v = to_local.vertices(tris.vertices) if len(tris.vertices) else tris.vertices
-    return Triangles(v, tris.faces, True)
+    return Triangles(v, tris.faces, tris.oriented)
 
 
 # ------------------------------------------------------------------ mesh

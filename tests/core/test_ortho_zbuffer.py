@@ -139,3 +139,30 @@ def test_mesh_top_raster_reproduces_the_dsm(scene):
     assert np.allclose(top, h, atol=1e-4)
     sub = mesh.heights_on(grid.window(10, 20, 30, 40))
     assert np.allclose(sub, h[10:40, 20:60], atol=1e-4)
+
+
+def test_walls_only_buffer_decides_like_the_full_surface(scene):
+    """Walls (+ tops next to them), double-sided, give the visibility of the full DSM surface."""
+    from truortho.core.ortho.surface import PlanTransform, grid_triangles
+
+    res = 0.2
+    h, gt = scene.dsm(res)
+    o = scene.offset
+    grid = RasterGrid.from_geotransform(gt, *h.shape, scene.config.crs)
+    full = dsm_triangles(h - o[2], gt[0] - o[0], gt[3] - o[1], res)
+    walls = grid_triangles(grid, h.astype(float), None, PlanTransform(None, None, o), 0.05)
+    assert not walls.oriented and len(walls) < 0.3 * len(full)
+    X, Y = grid.centres()
+    P = np.column_stack([X.ravel(), Y.ravel(), h.ravel()]) - o
+    cam = scene.camera
+    win = (0, 0, cam.width, cam.height)
+    for i in (0, len(scene.images) - 1):
+        im = scene.orientation.images[i]
+        d = P - im.C
+        dist = np.linalg.norm(d, axis=1)
+        cz = -d[:, 2] / dist
+        tol = depth_tolerance(res, dist / cam.fx / cz, np.sqrt(1 - cz**2) / cz)
+        v_full = point_visibility(P, tol, im.R, im.C, cam, render_depth(full, im.R, im.C, cam, win), win)[0]
+        v_walls = point_visibility(P, tol, im.R, im.C, cam, render_depth(walls, im.R, im.C, cam, win), win)[0]
+        seen = v_full | v_walls
+        assert (v_full == v_walls)[seen].mean() > 0.995
