@@ -35,7 +35,7 @@ import numpy as np
 from ..geometry.camera import Camera
 from ..grid import RasterGrid, Tile
 from .surface import PlanTransform
-from .zbuffer import depth_tolerance, point_visibility, project, render_depth
+from .zbuffer import frame_cells, render_depth, view_cells
 
 
 @dataclass
@@ -260,7 +260,7 @@ def tile_views(
             include = (dist == 0) | (hreg - zlow > dist / math.tan(setup.max_view) - res)
         tris = surface.triangles(region, hreg, include, to_local, setup.wall_min)
     normals3 = _normals(h, res)
-    normals = normals3.reshape(-1, 3)
+    normals = np.ascontiguousarray(normals3.reshape(-1, 3))
     # colour sample points: cells next to a height discontinuity are sampled a little inside their own
     # side, so the bilinear sample does not mix in the other side of a building outline
     S = P
@@ -282,60 +282,46 @@ def tile_views(
             S[mi, 0], S[mi, 1], S[mi, 2] = slx, sly, sz
 
     vidx = np.flatnonzero(vflat)
-    Pv = P[vidx]
-    cos_max = math.cos(setup.max_view)
+    Pv = np.ascontiguousarray(P[vidx])
 
     def one(k):
         im = setup.images[k]
         cam = setup.cameras[k]
-        # cells inside the frame first (one cheap projection), everything else on that subset
-        uvz = project(Pv, im.R, im.C, cam)
-        u, v, depth = uvz[:, 0], uvz[:, 1], uvz[:, 2]
-        inside = (depth > 0) & (u >= -0.5) & (u <= cam.width - 0.5) & (v >= -0.5) & (v <= cam.height - 0.5)
-        sub = np.flatnonzero(inside)
+        sub, uvp, dist = frame_cells(Pv, im.R, im.C, cam, setup.max_view)
         if not len(sub):
             return None
-        d = im.C[None, :] - Pv[sub]
-        dist = np.sqrt(np.einsum("ij,ij->i", d, d))
-        ray = d / np.maximum(dist, 1e-9)[:, None]
-        cos_view = ray[:, 2]
-        ok = cos_view >= cos_max
-        if not ok.any():
-            return None
-        sub, d, dist, ray, cos_view = sub[ok], d[ok], dist[ok], ray[ok], cos_view[ok]
         idx = vidx[sub]
-        gsd = float(np.median(dist / cam.fx))
+        gsd = float(np.median(dist)) / cam.fx
         scale = min(1.0, setup.oversample * gsd / res) if setup.visibility else 1.0
-        uvb = (uvz[sub, :2] + 0.5) * scale - 0.5
-        bw = max(1, int(round(cam.width * scale)))
-        bh = max(1, int(round(cam.height * scale)))
-        x0 = max(int(math.floor(uvb[:, 0].min())) - 2, 0)
-        y0 = max(int(math.floor(uvb[:, 1].min())) - 2, 0)
-        x1 = min(int(math.ceil(uvb[:, 0].max())) + 2, bw - 1)
-        y1 = min(int(math.ceil(uvb[:, 1].max())) + 2, bh - 1)
-        win = (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
-        cos_inc = np.einsum("ij,ij->i", normals[idx], ray)
-        good = cos_inc > 0.02  # the surface faces the camera
+        zb = win = None
         if setup.visibility:
+            uvb = (uvp + 0.5) * scale - 0.5
+            bw = max(1, int(round(cam.width * scale)))
+            bh = max(1, int(round(cam.height * scale)))
+            x0 = max(int(math.floor(uvb[:, 0].min())) - 2, 0)
+            y0 = max(int(math.floor(uvb[:, 1].min())) - 2, 0)
+            x1 = min(int(math.ceil(uvb[:, 0].max())) + 2, bw - 1)
+            y1 = min(int(math.ceil(uvb[:, 1].max())) + 2, bh - 1)
+            win = (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
             zb = render_depth(tris, im.R, im.C, cam, win, scale)
-            cv = np.maximum(cos_view, 1e-6)
-            tan_view = np.sqrt(np.maximum(1.0 - cos_view**2, 0.0)) / cv
-            foot = dist / (cam.fx * scale) / cv
-            tol = depth_tolerance(res, foot, tan_view, setup.tol_factor)
-            vis, ne, _, _ = point_visibility(P[idx], tol, im.R, im.C, cam, zb, win, scale)
-            good &= vis
-            ne &= good
-        else:
-            ne = np.zeros(len(idx), bool)
-        uvs = project(S[idx], im.R, im.C, cam)
-        good &= uvs[:, 2] > 0
-        uvk = uvs[:, :2].astype(np.float32)
-        # next to an occluder: the nearest pixel (the one that passed the depth test) instead of a
-        # bilinear mix with the occluder's pixels
-        uvk[ne] = np.round(uvk[ne])
-        gi = idx[good]
-        eff = (dist[good] / (cam.fx * cos_inc[good])).astype(np.float32)
-        return gi, ne[good], uvk[good], eff, gsd
+        # one fused pass: depth test, near-occluder test, incidence, effective resolution, sample
+        # coordinates (the nearest pixel next to an occluder instead of a bilinear mix with it)
+        good, ne, uvk, eff = view_cells(
+            idx,
+            P,
+            S,
+            normals,
+            im.R,
+            im.C,
+            cam,
+            zb,
+            win,
+            scale,
+            res,
+            setup.tol_factor,
+            setup.visibility,
+        )
+        return idx[good], ne[good], uvk[good], eff[good], gsd
 
     if workers > 1 and len(cand_all) > 1:
         from concurrent.futures import ThreadPoolExecutor

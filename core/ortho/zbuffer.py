@@ -503,3 +503,217 @@ def depth_tolerance(res: float, pixel_footprint, tan_view, factor: float = 1.0) 
     ``res`` deviate from a sloped surface by up to a cell step.
     """
     return factor * np.maximum(float(res), pixel_footprint) * (1.0 + np.asarray(tan_view))
+
+
+# ---------------------------------------------------------------- fused per-image cell passes
+
+
+@njit
+def _frame_pass(P, R, C, p, r2max, width, height, cos_max, u_out, v_out, dist_out):
+    """Cells in front, inside the frame and within the viewing angle: 1, else 0 (returned array)."""
+    n = P.shape[0]
+    ok = np.zeros(n, np.uint8)
+    for i in range(n):
+        dx = C[0] - P[i, 0]
+        dy = C[1] - P[i, 1]
+        dz = C[2] - P[i, 2]
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        if dist <= 0.0 or dz / dist < cos_max:
+            continue
+        u, v, z = _proj(P[i, 0], P[i, 1], P[i, 2], R, C, p, r2max)
+        if z <= 0.0 or u < -0.5 or v < -0.5 or u > width - 0.5 or v > height - 0.5:
+            continue
+        ok[i] = 1
+        u_out[i] = u
+        v_out[i] = v
+        dist_out[i] = dist
+    return ok
+
+
+@njit
+def _view_pass(
+    idx,
+    P,
+    S,
+    normals,
+    R,
+    C,
+    p_full,
+    p_buf,
+    r2max,
+    scale,
+    res,
+    tol_factor,
+    min_cos_inc,
+    zbuf,
+    x0,
+    y0,
+    use_vis,
+    good,
+    edge,
+    us,
+    vs,
+    eff,
+):
+    """Depth test (optional), incidence, effective resolution and sample coordinates of cells.
+
+    ``P`` surface points, ``S`` colour sample points, ``normals`` unit normals, all (N, 3);
+    the cells ``idx`` (n,) are processed, outputs (n,) in that order.
+    Tolerance as :func:`depth_tolerance`; ``zbuf`` window origin ``(x0, y0)`` in buffer pixels.
+    """
+    H = zbuf.shape[0]
+    W = zbuf.shape[1]
+    fx = p_full[0]
+    for m in range(idx.shape[0]):
+        n = idx[m]
+        good[m] = 0
+        edge[m] = 0
+        dx = C[0] - P[n, 0]
+        dy = C[1] - P[n, 1]
+        dz = C[2] - P[n, 2]
+        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
+        cos_view = dz / dist
+        cos_inc = (normals[n, 0] * dx + normals[n, 1] * dy + normals[n, 2] * dz) / dist
+        if cos_inc <= min_cos_inc or cos_view <= 1e-6:
+            continue
+        if use_vis:
+            u, v, z = _proj(P[n, 0], P[n, 1], P[n, 2], R, C, p_buf, r2max)
+            if z <= 0.0:
+                continue
+            i = np.int64(math.floor(u - x0 + 0.5))
+            j = np.int64(math.floor(v - y0 + 0.5))
+            if i < 0 or j < 0 or i >= W or j >= H:
+                continue
+            tan_view = math.sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view
+            foot = dist / (fx * scale) / cos_view
+            t = tol_factor * max(res, foot) * (1.0 + tan_view)
+            if z > zbuf[j, i] + t:
+                continue
+            zmin = np.inf
+            for jj in range(max(j - 1, 0), min(j + 2, H)):
+                for ii in range(max(i - 1, 0), min(i + 2, W)):
+                    if zbuf[jj, ii] < zmin:
+                        zmin = zbuf[jj, ii]
+            if zmin < z - t:
+                edge[m] = 1
+        su, sv, sz = _proj(S[n, 0], S[n, 1], S[n, 2], R, C, p_full, r2max)
+        if sz <= 0.0:
+            edge[m] = 0
+            continue
+        if edge[m]:
+            su = math.floor(su + 0.5)
+            sv = math.floor(sv + 0.5)
+        good[m] = 1
+        us[m] = su
+        vs[m] = sv
+        eff[m] = dist / (fx * cos_inc)
+
+
+def frame_cells(points, R, C, camera: Camera, max_view_rad: float):
+    """Cells seen inside the frame, in front, within the viewing angle.
+
+    Returns ``(index (m,) int, uv (m, 2) float64 full-resolution pixels, distance (m,) metres)``.
+    """
+    Rm, Cv = _pose(R, C)
+    P = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+    n = len(P)
+    u = np.empty(n)
+    v = np.empty(n)
+    d = np.empty(n)
+    ok = _frame_pass(
+        P,
+        Rm,
+        Cv,
+        camera.params,
+        valid_radius2(camera),
+        float(camera.width),
+        float(camera.height),
+        math.cos(max_view_rad),
+        u,
+        v,
+        d,
+    )
+    idx = np.flatnonzero(ok)
+    return idx, np.column_stack([u[idx], v[idx]]), d[idx]
+
+
+def view_cells(
+    idx,
+    points,
+    samples,
+    normals,
+    R,
+    C,
+    camera: Camera,
+    zbuf,
+    window,
+    scale: float,
+    res: float,
+    tol_factor: float = 1.0,
+    visibility: bool = True,
+    min_cos_inc: float = 0.02,
+):
+    """Per-cell result of one image in one pass (:func:`point_visibility` + incidence + sampling).
+
+    Parameters
+    ----------
+    idx : (n,) int
+        The cells to process (rows of the arrays below).
+    points, samples, normals : (N, 3) float64, C-contiguous
+        Surface points, colour sample points (local frame) and unit surface normals.
+    zbuf, window, scale : the depth buffer of :func:`render_depth` (ignored without ``visibility``).
+
+    Returns
+    -------
+    good : (n,) bool
+        Visible (when tested), facing the camera and projecting in front.
+    near_edge : (n,) bool
+    uv : (n, 2) float32
+        Full-resolution sample coordinates (rounded to the pixel centre next to an occluder).
+    eff : (n,) float32
+        Effective ground resolution ``distance / (fx cos incidence)``, metres.
+    """
+    Rm, Cv = _pose(R, C)
+    ix = np.ascontiguousarray(np.asarray(idx, dtype=np.int64))
+    P = np.ascontiguousarray(np.asarray(points, dtype=np.float64))
+    Sm = np.ascontiguousarray(np.asarray(samples, dtype=np.float64))
+    N = np.ascontiguousarray(np.asarray(normals, dtype=np.float64))
+    if not (P.shape == Sm.shape == N.shape and P.ndim == 2 and P.shape[1] == 3):
+        raise InputError("view_cells: points, samples and normals must be (N, 3) arrays of one shape")
+    if len(ix) and (ix.min() < 0 or ix.max() >= len(P)):
+        raise InputError("view_cells: cell index out of range")
+    n = len(ix)
+    if zbuf is None:
+        zbuf = np.full((1, 1), np.inf, np.float32)
+        window = (0, 0, 1, 1)
+    good = np.empty(n, np.uint8)
+    edge = np.empty(n, np.uint8)
+    us = np.full(n, np.nan)
+    vs = np.full(n, np.nan)
+    eff = np.full(n, np.inf)
+    _view_pass(
+        ix,
+        P,
+        Sm,
+        N,
+        Rm,
+        Cv,
+        camera.params,
+        scaled_params(camera, scale),
+        valid_radius2(camera),
+        float(scale),
+        float(res),
+        float(tol_factor),
+        float(min_cos_inc),
+        zbuf,
+        float(window[0]),
+        float(window[1]),
+        bool(visibility),
+        good,
+        edge,
+        us,
+        vs,
+        eff,
+    )
+    g = good.astype(bool)
+    return g, edge.astype(bool) & g, np.column_stack([us, vs]).astype(np.float32), eff.astype(np.float32)
