@@ -280,3 +280,32 @@ def test_mesh_surface_gives_the_dsm_result(data, tmp_path, as_file):
     rgb = np.moveaxis(a[:3], 0, -1)
     gh = ev.ghosting(rgb, truth, a[3] > 0, ev.building_mask(scene, g), 2.0)
     assert gh["cells"] > 500 and gh["share"] <= 0.02
+
+
+def test_dsm_in_another_crs_is_resampled_onto_the_output_grid(data, tmp_path):
+    import rasterio
+    from rasterio.warp import Resampling, calculate_default_transform, reproject
+
+    f = data["folder"]
+    src = f / "dsm.tif"
+    dst = tmp_path / "dsm_25832.tif"
+    with rasterio.open(src) as ds:
+        tr, w, h = calculate_default_transform(ds.crs, "EPSG:25832", ds.width, ds.height, *ds.bounds)
+        prof = ds.profile | {"crs": "EPSG:25832", "transform": tr, "width": w, "height": h}
+        with rasterio.open(dst, "w", **prof) as out:
+            reproject(
+                rasterio.band(ds, 1),
+                rasterio.band(out, 1),
+                dst_crs="EPSG:25832",
+                dst_transform=tr,
+                resampling=Resampling.nearest,
+            )
+    ext = data["scene"].extent_world()
+    sub = (ext[0] + 20, ext[1] + 20, ext[0] + 60, ext[1] + 50)
+    cfg = TrueOrthoConfig(extent=sub, resolution=data["res"], color_correction=False)
+    r1 = true_ortho(f / "orientation.json", dst, tmp_path / "a.tif", tmp_path / "ai.tif", config=cfg)
+    r2 = true_ortho(f / "orientation.json", src, tmp_path / "b.tif", tmp_path / "bi.tif", config=cfg)
+    assert r1.grid.crs == "EPSG:32632"
+    i1, _, _ = read_raster(r1.source_index)
+    i2, _, _ = read_raster(r2.source_index)
+    assert (i1 == i2).mean() > 0.95
