@@ -249,6 +249,8 @@ def true_ortho(
     o = _load_orientation(orientation)
     if not o.images:
         raise InputError("ORIENTATION: the orientation holds no image")
+    if len(o.images) > 32767 and source_index is not None:
+        raise InputError(f"SOURCE_INDEX: {len(o.images)} images do not fit an int16 index (at most 32767)")
     surf = open_surface(surface)
     o_crs = o.crs
     if o_crs is None and (surf.crs is not None or cfg.crs is not None):
