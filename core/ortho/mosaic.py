@@ -219,8 +219,16 @@ def mosaic_tile(
     seen = usable.any(axis=0)
     occl[valid & seen] = 0
     cost = data_costs(views.eff_res, usable, views.near_edge, params.edge_penalty)
-    colours = candidate_colours(views, store, correction, res)
+    # raw colours of every candidate; the seam cost uses their luminance corrected by the
+    # lightness (or first band) gain and offset, the full correction is applied below only to
+    # the samples that enter the mosaic
+    colours = candidate_colours(views, store, None, res)
     lum = luminance01(colours, store.dtype)
+    if correction is not None:
+        for k, i in enumerate(views.cands):
+            if not correction.is_identity(int(i)):
+                g, o = correction.gain[int(i), 0], correction.offset[int(i), 0]
+                lum[k] = g * lum[k] + (o / 100.0 if correction.lab else o / value_scale(store.dtype))
     local_fixed = None
     if fixed is not None and (fixed >= 0).any():
         lut = {int(g): k for k, g in enumerate(views.cands)}
@@ -240,6 +248,11 @@ def mosaic_tile(
     )
     clean = usable & ~views.near_edge
     w = feather_weights(labels, clean, params.blend_width)
+    if correction is not None:
+        for k, i in enumerate(views.cands):
+            m = w[k] > 0
+            if m.any() and not correction.is_identity(int(i)):
+                colours[k][m] = correction.apply(int(i), colours[k][m], store.dtype).astype(np.float32)
     col = np.where(np.isfinite(colours), colours, 0.0)
     values = np.einsum("krc,krcb->brc", w, col, optimize=True).astype(np.float32)
     alpha = labels >= 0
