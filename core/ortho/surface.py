@@ -5,9 +5,9 @@ Every surface answers two questions for a window of the output grid:
 * :meth:`heights_on` -- the surface height (world z) at every cell centre, NaN
   where the surface has no data. A DSM is resampled onto the grid with
   *nearest* neighbour (a point sample of the cell the centre falls in, so
-  building outlines stay sharp and every ortho cell lies on a face of the
-  depth-buffer surface); a mesh is rasterised from above (highest face at the
-  cell centre).
+  building outlines stay sharp), bilinearly when it is more than 1.5 times
+  coarser than the cells (:func:`_resampling`); a mesh is rasterised from
+  above (highest face at the cell centre).
 * :meth:`triangles` -- the occluding surface in the orientation's local frame
   for the depth buffers (:mod:`.zbuffer`): for a DSM the cell tops and walls of
   the resampled heights (:func:`~.zbuffer.dsm_triangles`), for a mesh its own
@@ -198,9 +198,11 @@ class DsmSurface:
         return self._range
 
     def heights_on(self, grid: RasterGrid) -> np.ndarray:
-        """World heights (rows, cols) float64 at the cell centres of ``grid`` (nearest), NaN = no data."""
+        """World heights (rows, cols) float64 at the cell centres of ``grid`` (NaN = no data).
+
+        Resampled as :func:`_resampling` says.
+        """
         import rasterio
-        from rasterio.enums import Resampling
         from rasterio.warp import reproject
 
         dst = np.full(grid.shape, np.nan, np.float64)
@@ -213,7 +215,7 @@ class DsmSurface:
                     dst_transform=grid.transform,
                     dst_crs=_crs_obj(grid.crs or self.crs),
                     dst_nodata=np.nan,
-                    resampling=Resampling.nearest,
+                    resampling=_resampling(self, grid),
                 )
             except Exception as exc:
                 raise CRSError(
@@ -265,7 +267,6 @@ class ArraySurface(DsmSurface):
                 if rs1 > rs0 and cs1 > cs0:
                     out[rs0 - r0 : rs1 - r0, cs0 - c0 : cs1 - c0] = self.h[rs0:rs1, cs0:cs1]
                 return out
-        from rasterio.enums import Resampling
         from rasterio.warp import reproject
 
         dst = np.full(grid.shape, np.nan, np.float64)
@@ -279,11 +280,27 @@ class ArraySurface(DsmSurface):
                 dst_transform=grid.transform,
                 dst_crs=_crs_obj(grid.crs or self.crs),
                 dst_nodata=np.nan,
-                resampling=Resampling.nearest,
+                resampling=_resampling(self, grid),
             )
         except Exception as exc:
             raise CRSError(f"{self.name}: cannot resample the heights onto the output grid ({exc})") from None
         return dst
+
+
+def _resampling(surface, grid: RasterGrid):
+    """Nearest neighbour (sharp outlines) unless the DSM is much coarser than the output grid.
+
+    A DSM more than 1.5 times coarser than the cells is interpolated bilinearly:
+    nearest neighbour would turn every slope into blocks of output cells with
+    artificial steps (walls in the depth buffers, occluded stripes behind them),
+    and such a DSM has no outline sharper than its own cells anyway.
+    """
+    from rasterio.enums import Resampling
+
+    res = getattr(surface, "res", None)
+    if res and same_crs(surface.crs, grid.crs) and res > 1.5 * grid.res:
+        return Resampling.bilinear
+    return Resampling.nearest
 
 
 def grid_triangles(

@@ -493,16 +493,20 @@ def point_visibility(points, tol, R, C, camera: Camera, zbuf: np.ndarray, window
     return vis.astype(bool), edge.astype(bool), uv, z
 
 
-def depth_tolerance(res: float, pixel_footprint, tan_view, factor: float = 1.0) -> np.ndarray:
+def depth_tolerance(res: float, pixel_footprint, tan_view, factor: float = 1.0, slope=0.0) -> np.ndarray:
     """Depth tolerance (metres) of the visibility test.
 
-    ``factor * max(res, pixel_footprint) * (1 + tan_view)``: within one buffer
-    pixel of footprint ``pixel_footprint`` (metres on the ground) the depth of a
-    surface seen at off-nadir angle ``atan(tan_view)`` varies by about
-    ``pixel_footprint * tan_view``, and the flat cell tops of a DSM of cell size
-    ``res`` deviate from a sloped surface by up to a cell step.
+    ``factor * (max(res, pixel_footprint) * (1 + tan_view) + res * slope)``:
+    within one buffer pixel of footprint ``pixel_footprint`` (metres on the
+    ground) the depth of a surface seen at off-nadir angle ``atan(tan_view)``
+    varies by about ``pixel_footprint * tan_view``, and the flat cell tops of a
+    DSM of cell size ``res`` deviate from a surface of gradient ``slope`` by up
+    to one stair step ``res * slope`` (the slope from the smaller one-sided
+    height differences, so a cell next to a wall keeps the slope of its own
+    roof or ground). The fused pass of :func:`view_cells` uses the same formula.
     """
-    return factor * np.maximum(float(res), pixel_footprint) * (1.0 + np.asarray(tan_view))
+    base = np.maximum(float(res), pixel_footprint) * (1.0 + np.asarray(tan_view))
+    return factor * (base + float(res) * np.asarray(slope))
 
 
 # ---------------------------------------------------------------- fused per-image cell passes
@@ -586,7 +590,9 @@ def _view_pass(
                 continue
             tan_view = math.sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view
             foot = dist / (fx * scale) / cos_view
-            t = tol_factor * max(res, foot) * (1.0 + tan_view)
+            nz = max(abs(normals[n, 2]), 1e-6)
+            slope = math.sqrt(max(1.0 - nz * nz, 0.0)) / nz  # the cell's own stair step per cell
+            t = tol_factor * (max(res, foot) * (1.0 + tan_view) + res * slope)
             if z > zbuf[j, i] + t:
                 continue
             zmin = np.inf
