@@ -13,6 +13,7 @@ from .importorientation import ImportOrientationAlgorithm
 from .mesh import MeshAlgorithm
 from .orientimages import OrientImagesAlgorithm
 from .pointcloud import DsmToPointCloudAlgorithm, MergePointCloudsAlgorithm
+from .trueortho import TrueOrthoAlgorithm
 
 ALGORITHMS: list[type] = [
     EnvironmentAlgorithm,
@@ -20,6 +21,7 @@ ALGORITHMS: list[type] = [
     ExportOrientationAlgorithm,
     ImportGcpsAlgorithm,
     OrientImagesAlgorithm,
+    TrueOrthoAlgorithm,
     DsmFilterAlgorithm,
     MeshAlgorithm,
     DsmToPointCloudAlgorithm,

@@ -9,6 +9,7 @@ from ..i18n import tr
 
 GROUPS = {
     "orientation": "Orientation",
+    "orthophoto": "Orthophoto",
     "surface": "Surface",
     "tools": "Tools",
 }

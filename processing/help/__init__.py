@@ -108,6 +108,46 @@ HELP: dict[str, dict] = {
             "surveyed).",
         },
     },
+    "trueortho": {
+        "summary": (
+            "Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, "
+            "or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a "
+            "depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height "
+            "steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a "
+            "cell the one with the finest effective ground resolution (distance and incidence on the "
+            "surface) is preferred; roofs are textured from one image each and seamlines follow height "
+            "discontinuities and avoid places where the images disagree (label smoothing), with feathering "
+            "across seams only between images that both see the cells. Per-image colour corrections in "
+            "CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells "
+            "seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. "
+            "Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). "
+            "Processing runs by tiles with bounded memory; progress and cancel per tile."
+        ),
+        "parameters": {
+            "ORIENTATION": "Orientation JSON (from Orient images or Import orientation); its images must "
+            "be on disk.",
+            "SURFACE": "DSM GeoTIFF (any CRS; resampled onto the output grid by nearest neighbour) or a "
+            "PLY/OBJ mesh. Heights must use the orientation's vertical datum. It must cover the extent.",
+            "EXTENT": "Output extent; default the surface's extent.",
+            "RESOLUTION": "Output cell size in units of the output CRS; 0 = the DSM's cell size.",
+            "CRS": "Output CRS; default the orientation's. When it differs, the computation runs on the "
+            "output grid and cell centres are transformed to the orientation's CRS (images are resampled "
+            "once).",
+            "COLOR_CORRECTION": "Estimate and apply per-image colour corrections before mosaicking.",
+            "MAX_VIEW_ANGLE": "Largest off-nadir angle of the viewing ray (degrees) for an image to texture "
+            "a cell; also bounds how far outside a tile occluders are searched.",
+            "BLEND_WIDTH": "Width of the feathering across seamlines, in cells (0 = hard seams).",
+            "TILE_SIZE": "Tile side in cells; memory grows with its square and the images per tile.",
+            "OUTPUT": "GeoTIFF with the images' bands and data type plus an alpha band, tiled, with "
+            "overviews, Cloud-Optimized GeoTIFF layout.",
+            "SOURCE_INDEX": "Int16 GeoTIFF: index (0-based, orientation order) of the image each cell "
+            "comes from; -1 = nodata.",
+            "OCCLUSION": "UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the "
+            "surface has no data.",
+            "SEAMLINES": "Polygons, one feature per source image: the cells it colours (image_index, "
+            "image, cells, area).",
+        },
+    },
     "dsmfilter": {
         "summary": (
             "Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the "

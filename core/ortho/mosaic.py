@@ -1,0 +1,271 @@
+"""Image access for the mosaic and the per-tile mosaicking.
+
+:class:`ImageStore` decodes source images on demand, keeps a least-recently-used
+cache bounded in bytes, and serves reduced levels (area-averaged halvings) so
+an output cell coarser than the image pixel samples a pixel of about its own
+size instead of aliasing. :func:`sample` reads the colours of a tile's cells
+from one image (bilinear, OpenCV ``remap``), any band count and dtype.
+
+:func:`mosaic_tile` turns the visibility of a tile (:mod:`.views`) into output
+values: data costs and labels (:mod:`.select`), colours of every candidate
+corrected radiometrically (:mod:`.color`), feathering across seams
+(:mod:`.seams`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import FormatError, InputError
+from ..imagery import read_image
+from .color import ColorCorrection, value_scale
+from .seams import feather_weights
+from .select import data_costs, select_labels
+from .views import TileViews
+
+
+class ImageStore:
+    """Decoded images by (index, level) with an LRU cache of at most ``max_bytes``."""
+
+    def __init__(
+        self, paths: list[str], sizes: list[tuple[int, int]], bands: int, dtype, max_bytes: int = 1 << 30
+    ) -> None:
+        self.paths = paths
+        self.sizes = sizes
+        self.bands = int(bands)
+        self.dtype = np.dtype(dtype)
+        self.max_bytes = int(max_bytes)
+        self._cache: OrderedDict = OrderedDict()
+        self._bytes = 0
+        self.reads = 0
+
+    def get(self, i: int, level: int = 0) -> np.ndarray:
+        key = (int(i), int(level))
+        if key in self._cache:
+            self._cache.move_to_end(key)
+            return self._cache[key]
+        if level == 0:
+            img = read_image(self.paths[i])
+            self.reads += 1
+            w, h = self.sizes[i]
+            if img.shape[:2] != (h, w):
+                raise FormatError(
+                    self.paths[i],
+                    f"image is {img.shape[1]} x {img.shape[0]} pixels but its camera says {w} x {h}",
+                )
+            nb = 1 if img.ndim == 2 else img.shape[2]
+            if nb != self.bands or img.dtype != self.dtype:
+                raise FormatError(
+                    self.paths[i],
+                    f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
+                )
+        else:
+            import cv2
+
+            src = self.get(i, level - 1)
+            h, w = src.shape[:2]
+            nw, nh = max(1, (w + 1) // 2), max(1, (h + 1) // 2)
+            if src.ndim == 3 and src.shape[2] > 4:
+                img = np.stack(
+                    [
+                        cv2.resize(src[:, :, c], (nw, nh), interpolation=cv2.INTER_AREA)
+                        for c in range(src.shape[2])
+                    ],
+                    -1,
+                )
+            else:
+                img = cv2.resize(src, (nw, nh), interpolation=cv2.INTER_AREA)
+        img = np.ascontiguousarray(img)
+        self._cache[key] = img
+        self._bytes += img.nbytes
+        while self._bytes > self.max_bytes and len(self._cache) > 1:
+            _, old = self._cache.popitem(last=False)
+            self._bytes -= old.nbytes
+        return img
+
+    def level_for(self, gsd: float, res: float) -> int:
+        """Level whose pixel (``gsd * 2**level``) is at most the output cell ``res``."""
+        if not (gsd > 0 and res > 0):
+            return 0
+        return max(0, min(8, int(math.floor(math.log2(res / gsd) + 1e-9))))
+
+
+def sample(img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, int]) -> np.ndarray:
+    """Bilinear samples ``(rows, cols, bands)`` float32 at full-resolution pixel coordinates ``uv``.
+
+    ``uv``: (rows, cols, 2) float32, NaN where not needed (sampled as 0).
+    At ``level`` > 0 coordinates map as ``x' = (x + 0.5) * w'/w - 0.5``.
+    """
+    import cv2
+
+    h, w = img.shape[:2]
+    W, H = full_size
+    sx, sy = w / W, h / H
+    mx = ((uv[..., 0] + 0.5) * sx - 0.5).astype(np.float32)
+    my = ((uv[..., 1] + 0.5) * sy - 0.5).astype(np.float32)
+    bad = ~(np.isfinite(mx) & np.isfinite(my))
+    mx[bad] = -10.0
+    my[bad] = -10.0
+    src = img if img.dtype in (np.uint8, np.uint16, np.int16, np.float32) else img.astype(np.float32)
+    chans = (
+        [src]
+        if src.ndim == 2
+        else ([src] if src.shape[2] <= 4 else [src[:, :, c] for c in range(src.shape[2])])
+    )
+    outs = []
+    for ch in chans:
+        o = cv2.remap(ch, mx, my, interpolation=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
+        if o.ndim == 2:
+            o = o[:, :, None]
+        outs.append(o.astype(np.float32))
+    return np.concatenate(outs, axis=2) if len(outs) > 1 else outs[0]
+
+
+def luminance01(col: np.ndarray, dtype) -> np.ndarray:
+    """Luminance in [0, 1]-ish units of samples (..., bands) float32 (Rec. 601 for RGB, band 1 otherwise)."""
+    s = value_scale(dtype)
+    if col.shape[-1] >= 3:
+        lum = 0.299 * col[..., 0] + 0.587 * col[..., 1] + 0.114 * col[..., 2]
+    else:
+        lum = col[..., 0]
+    return (lum / s).astype(np.float32)
+
+
+@dataclass
+class MosaicParams:
+    """Selection and blending parameters (see :class:`~.pipeline.TrueOrthoConfig`)."""
+
+    edge_penalty: float = 1.0
+    smoothness: float = 1.0
+    contrast: float = 4.0
+    discontinuity: float = 0.5
+    blend_width: int = 5
+    sweeps: int = 8
+
+
+@dataclass
+class TileMosaic:
+    """Output of one tile's outer window.
+
+    values : (bands, rows, cols) float32 (0 where no data); alpha : (rows, cols) bool;
+    label : (rows, cols) int, global image index or -1; occlusion : (rows, cols) uint8
+    (0 seen, 1 seen by no image, 255 no surface).
+    """
+
+    values: np.ndarray
+    alpha: np.ndarray
+    label: np.ndarray
+    occlusion: np.ndarray
+
+
+def candidate_colours(
+    views: TileViews,
+    store: ImageStore,
+    correction: ColorCorrection | None,
+    res: float,
+    needed: np.ndarray | None = None,
+) -> np.ndarray:
+    """Corrected colours ``(K, rows, cols, bands)`` float32 of every candidate where usable.
+
+    NaN where the candidate is not usable (or not ``needed``).
+    """
+    K, rows, cols = views.usable.shape
+    out = np.full((K, rows, cols, store.bands), np.nan, np.float32)
+    for k in range(K):
+        m = views.usable[k] if needed is None else (views.usable[k] & needed[k])
+        if not m.any():
+            continue
+        i = int(views.cands[k])
+        level = store.level_for(float(views.gsd[k]), res)
+        img = store.get(i, level)
+        col = sample(img, views.uv[k], level, store.sizes[i])
+        vals = col[m]
+        if correction is not None and not correction.is_identity(i):
+            vals = correction.apply(i, vals, store.dtype).astype(np.float32)
+        out[k][m] = vals
+    return out
+
+
+def mosaic_tile(
+    views: TileViews,
+    store: ImageStore,
+    correction: ColorCorrection | None,
+    res: float,
+    params: MosaicParams,
+    fixed: np.ndarray | None = None,
+) -> TileMosaic:
+    """Labels, blended colours, alpha and occlusion of a tile's outer window.
+
+    ``fixed``: (rows, cols) global image indices already written by neighbouring
+    tiles (-1 = free), continued here (:func:`~.select.select_labels`).
+    """
+    rows, cols = views.heights.shape
+    valid = np.isfinite(views.heights)
+    bands = store.bands
+    K = len(views.cands)
+    occl = np.where(valid, 1, 255).astype(np.uint8)
+    if K == 0:
+        return TileMosaic(
+            np.zeros((bands, rows, cols), np.float32),
+            np.zeros((rows, cols), bool),
+            np.full((rows, cols), -1, np.int64),
+            occl,
+        )
+    usable = views.usable & valid[None]
+    seen = usable.any(axis=0)
+    occl[valid & seen] = 0
+    cost = data_costs(views.eff_res, usable, views.near_edge, params.edge_penalty)
+    # raw colours of every candidate; the seam cost uses their luminance corrected by the
+    # lightness (or first band) gain and offset, the full correction is applied below only to
+    # the samples that enter the mosaic
+    colours = candidate_colours(views, store, None, res)
+    lum = luminance01(colours, store.dtype)
+    if correction is not None:
+        for k, i in enumerate(views.cands):
+            if not correction.is_identity(int(i)):
+                g, o = correction.gain[int(i), 0], correction.offset[int(i), 0]
+                lum[k] = g * lum[k] + (o / 100.0 if correction.lab else o / value_scale(store.dtype))
+    local_fixed = None
+    if fixed is not None and (fixed >= 0).any():
+        lut = {int(g): k for k, g in enumerate(views.cands)}
+        local_fixed = np.full(fixed.shape, -1, np.int32)
+        for g, k in lut.items():
+            local_fixed[fixed == g] = k
+    labels = select_labels(
+        cost,
+        views.heights,
+        lum,
+        res,
+        params.smoothness,
+        params.contrast,
+        params.discontinuity,
+        sweeps=params.sweeps,
+        fixed=local_fixed,
+    )
+    clean = usable & ~views.near_edge
+    w = feather_weights(labels, clean, params.blend_width)
+    if correction is not None:
+        for k, i in enumerate(views.cands):
+            m = w[k] > 0
+            if m.any() and not correction.is_identity(int(i)):
+                colours[k][m] = correction.apply(int(i), colours[k][m], store.dtype).astype(np.float32)
+    col = np.where(np.isfinite(colours), colours, 0.0)
+    values = np.einsum("krc,krcb->brc", w, col, optimize=True).astype(np.float32)
+    alpha = labels >= 0
+    glabel = np.where(alpha, views.cands[np.clip(labels, 0, K - 1)], -1).astype(np.int64)
+    return TileMosaic(values, alpha, glabel, occl)
+
+
+def to_dtype(values: np.ndarray, dtype) -> np.ndarray:
+    """Round and clip float values to an output dtype."""
+    dt = np.dtype(dtype)
+    if dt.kind in "ui":
+        info = np.iinfo(dt)
+        return np.clip(np.round(values), info.min, info.max).astype(dt)
+    if dt.kind == "f":
+        return values.astype(dt)
+    raise InputError(f"unsupported image data type {dt}")

@@ -1,0 +1,571 @@
+"""The true orthophoto: orientation + surface -> mosaic, source index, occlusion mask, seamlines.
+
+:func:`true_ortho` runs, tile by tile with bounded memory:
+
+1. validation (before anything is written): orientation with a CRS, images on
+   disk with one band count and data type, a surface covering the extent, a
+   transformation path between the output CRS and the orientation's;
+2. colour correction (optional): per-image corrections estimated by least
+   squares from cells seen by several images, on a decimated copy of the output
+   grid (:mod:`.color`);
+3. per tile: visibility in every candidate image (:mod:`.views`), selection
+   and seams (:mod:`.select`), blending (:mod:`.mosaic`), written to the
+   outputs;
+4. seamline polygons (one per source image) from the source index.
+
+Reprojection: when the output CRS differs from the orientation's, the
+computation runs on the *output* grid: the surface is resampled onto it, and
+cell centres and depth-buffer vertices are transformed to the orientation's
+frame with pyproj. The images are thus resampled exactly once, directly into
+the output cells (no second warp of a finished mosaic), and the depth buffers
+still work on exact local coordinates.
+
+Outputs are GeoTIFFs written by tiles through
+:class:`~truortho.core.rasterio_io.RasterWriter` (temporary file renamed on
+success, tiled, internal overviews, COG layout): the mosaic with the source
+images' bands and data type plus an alpha band, the source index (int16, image
+index in the orientation, nodata -1) and the occlusion mask (uint8: 0 seen,
+1 seen by no image, nodata 255 where the surface has no data).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import CRSError, InputError, MissingFileError
+from ..grid import RasterGrid
+from ..imagery import image_info
+from ..orientation import Orientation
+from ..progress import Progress, Steps, as_progress, check
+from .color import ColorCorrection, estimate_corrections, to_channels
+from .mosaic import ImageStore, MosaicParams, candidate_colours, mosaic_tile, to_dtype
+from .seams import dissolve, region_polygons
+from .surface import PlanTransform, open_surface, same_crs, transform_bounds
+from .views import prepare_views, tile_views
+from .zbuffer import occluder_wall_min
+
+
+@dataclass
+class TrueOrthoConfig:
+    """Parameters of :func:`true_ortho`.
+
+    Attributes
+    ----------
+    resolution : float, optional
+        Output cell size in CRS units (metres); default the surface's cell size
+        (a DSM) or the median nadir GSD of the images (a mesh).
+    extent : (xmin, ymin, xmax, ymax), optional
+        In the output CRS; default the surface's extent.
+    crs : str, optional
+        Output CRS; default the orientation's.
+    color_correction : bool
+        Estimate and apply per-image corrections (:mod:`.color`).
+    max_view_angle : float
+        Largest off-nadir angle (degrees) of a viewing ray that may texture a cell.
+    blend_width : int
+        Feathering width across seams, cells (0 = none).
+    visibility : bool
+        False gives the conventional orthorectification (no depth test), for comparisons.
+    tile_size : int
+        Core tile side in cells (memory grows with its square times the images per tile).
+    depth_tolerance : float
+        Factor of :func:`~.zbuffer.depth_tolerance`.
+    edge_penalty, smoothness, contrast, discontinuity, sweeps
+        Selection energy (:mod:`.select`): penalty for a cell next to an
+        occluder, seam weight, weight of the luminance disagreement in a seam,
+        height step (m) of a discontinuity, ICM sweeps.
+    edge_shift : float
+        Cells next to a height discontinuity take their colour this many cells
+        inside their own side (0 = at the cell centre), so building outlines do
+        not mix roof and ground colours.
+    wall_min : float, optional
+        Height steps of the DSM below this (m) get no wall in the depth buffer
+        (which holds only the DSM's walls, see :func:`~.zbuffer.dsm_triangles`);
+        default :func:`~.zbuffer.occluder_wall_min` (a quarter cell over
+        tan(MAX_VIEW_ANGLE); steps below twice that cannot hide a cell seen within that angle).
+    zbuffer_oversample : float
+        Depth-buffer pixels per output cell when the image pixel is finer than the cell.
+    image_cache_mb : int
+        Bound of the decoded-image cache.
+    color_cells : int
+        Cells of the decimated grid used to estimate the colour correction.
+    workers : int
+        Threads for the per-image depth buffers of a tile.
+    cog : bool
+        Cloud-Optimized GeoTIFF layout (with overviews) for the rasters.
+    """
+
+    resolution: float | None = None
+    extent: tuple[float, float, float, float] | None = None
+    crs: str | None = None
+    color_correction: bool = True
+    max_view_angle: float = 45.0
+    blend_width: int = 5
+    visibility: bool = True
+    tile_size: int = 512
+    depth_tolerance: float = 1.0
+    edge_penalty: float = 1.0
+    smoothness: float = 1.0
+    contrast: float = 4.0
+    discontinuity: float = 0.5
+    sweeps: int = 8
+    edge_shift: float = 0.75
+    wall_min: float | None = None
+    zbuffer_oversample: float = 1.0
+    image_cache_mb: int = 1024
+    color_cells: int = 60_000
+    workers: int = 2
+    cog: bool = True
+
+    def validate(self) -> None:
+        def bad(name, why):
+            raise InputError(f"{name}: {why} (got {getattr(self, name)!r})")
+
+        if self.resolution is not None and not (
+            isinstance(self.resolution, int | float)
+            and math.isfinite(self.resolution)
+            and self.resolution > 0
+        ):
+            bad("resolution", "expected a positive cell size")
+        if not 0 < float(self.max_view_angle) < 89:
+            bad("max_view_angle", "expected degrees in (0, 89)")
+        if not isinstance(self.blend_width, int) or not 0 <= self.blend_width <= 1000:
+            bad("blend_width", "expected an integer number of cells in [0, 1000]")
+        if not isinstance(self.tile_size, int) or not 32 <= self.tile_size <= 8192:
+            bad("tile_size", "expected an integer in [32, 8192]")
+        for name in ("depth_tolerance", "zbuffer_oversample"):
+            if not float(getattr(self, name)) > 0:
+                bad(name, "must be positive")
+        for name in ("edge_penalty", "smoothness", "contrast", "discontinuity"):
+            if not float(getattr(self, name)) >= 0:
+                bad(name, "must not be negative")
+        if self.extent is not None and len(self.extent) != 4:
+            bad("extent", "expected (xmin, ymin, xmax, ymax)")
+
+
+@dataclass
+class SeamRegion:
+    """The cells of one source image: ``geometry`` a shapely (multi)polygon in the output CRS."""
+
+    image_index: int
+    image_name: str
+    cells: int
+    geometry: object
+
+    @property
+    def wkt(self) -> str:
+        return self.geometry.wkt  # type: ignore[attr-defined]
+
+
+@dataclass
+class TrueOrthoResult:
+    """Paths, grid, seam regions, colour correction and statistics of a run."""
+
+    output: Path
+    source_index: Path | None
+    occlusion: Path | None
+    grid: RasterGrid
+    seamlines: list[SeamRegion]
+    correction: ColorCorrection | None
+    stats: dict = field(default_factory=dict)
+
+
+def _load_orientation(orientation) -> Orientation:
+    if isinstance(orientation, Orientation):
+        return orientation
+    if isinstance(orientation, str | os.PathLike):
+        return Orientation.load(orientation)
+    raise InputError(f"ORIENTATION: expected an orientation file or object, got {type(orientation).__name__}")
+
+
+def _default_resolution(surface, orientation: Orientation, out_crs) -> float:
+    """The DSM's cell size when it is in the output CRS, else the median nadir GSD."""
+    same = surface.crs is None or out_crs is None or same_crs(surface.crs, out_crs)
+    if getattr(surface, "res", None) and same:
+        return float(surface.res)
+    lo, hi = surface.height_range()
+    z = 0.5 * (lo + hi) - orientation.offset[2]
+    g = [
+        abs(im.C[2] - z) / orientation.camera_of(im).fx
+        for im in orientation.images
+        if im.R[2, 2] < -math.cos(math.radians(20))
+    ]
+    if not g:
+        g = [abs(im.C[2] - z) / orientation.camera_of(im).fx for im in orientation.images]
+    return float(np.median(g))
+
+
+def true_ortho(
+    orientation,
+    surface,
+    output,
+    source_index=None,
+    occlusion=None,
+    config: TrueOrthoConfig | None = None,
+    progress: Progress | None = None,
+    image_root: str | os.PathLike | None = None,
+) -> TrueOrthoResult:
+    """Compute a true orthophoto.
+
+    Parameters
+    ----------
+    orientation : Orientation or path to an orientation JSON
+        Images, cameras and the CRS/offset of the local frame.
+    surface : path (GeoTIFF DSM, PLY/OBJ mesh), :class:`~.surface.DsmSurface`,
+        :class:`~.surface.ArraySurface`, :class:`~.surface.MeshSurface` or any
+        object with ``vertices``/``faces``/``crs``.
+    output : path
+        The mosaic GeoTIFF (bands of the images + alpha).
+    source_index, occlusion : path, optional
+        Source-index (int16) and occlusion-mask (uint8) GeoTIFFs.
+    config : TrueOrthoConfig
+    progress : Progress, optional
+        Reports per tile; cancelling leaves no output.
+    image_root : path, optional
+        Overrides the orientation's image folder.
+
+    Returns
+    -------
+    TrueOrthoResult
+
+    Raises
+    ------
+    InputError, MissingFileError, CRSError, FormatError
+        Bad input, detected before any output is written.
+    CancelledError
+    """
+    t_start = time.perf_counter()
+    cfg = config or TrueOrthoConfig()
+    cfg.validate()
+    steps = Steps(progress, [1, 3 if cfg.color_correction else 0, 12, 1])
+    prog = as_progress(progress)
+    o = _load_orientation(orientation)
+    if not o.images:
+        raise InputError("ORIENTATION: the orientation holds no image")
+    if len(o.images) > 32767 and source_index is not None:
+        raise InputError(f"SOURCE_INDEX: {len(o.images)} images do not fit an int16 index (at most 32767)")
+    surf = open_surface(surface)
+    o_crs = o.crs
+    if o_crs is None and (surf.crs is not None or cfg.crs is not None):
+        raise CRSError(
+            "ORIENTATION: the orientation has no CRS; a true orthophoto of a georeferenced "
+            "surface needs a georeferenced orientation"
+        )
+    if o_crs is not None:
+        from ..geometry.frame import parse_crs, require_metric
+
+        require_metric(parse_crs(o_crs), "ORIENTATION CRS")
+    out_crs = cfg.crs or o_crs
+    if out_crs is not None:
+        from ..geometry.frame import parse_crs
+
+        parse_crs(out_crs)
+    to_local = PlanTransform(out_crs, o_crs, o.offset)
+    # ---- grid and coverage of the surface
+    s_bounds = transform_bounds(surf.bounds, surf.crs or out_crs, out_crs)
+    res = float(cfg.resolution) if cfg.resolution else _default_resolution(surf, o, out_crs)
+    extent = tuple(float(v) for v in (cfg.extent or s_bounds))
+    grid = RasterGrid.from_extent(extent, res, out_crs)
+    gx0, gy0, gx1, gy1 = grid.extent
+    tol = 0.5 * res + 1e-6 * max(abs(gx0), abs(gy1), 1.0)
+    if surf.crs is not None and out_crs is not None and not same_crs(surf.crs, out_crs):
+        tol += 2.0 * res  # the surface's cells, reprojected, may end up to a cell inside
+    if (
+        gx0 < s_bounds[0] - tol
+        or gy0 < s_bounds[1] - tol
+        or gx1 > s_bounds[2] + tol
+        or gy1 > s_bounds[3] + tol
+    ):
+        raise InputError(
+            f"SURFACE {surf.path}: covers {tuple(round(v, 3) for v in s_bounds)} but EXTENT is "
+            f"{tuple(round(v, 3) for v in grid.extent)} (in {out_crs}); give a smaller extent or a "
+            "surface covering it"
+        )
+    # transformation path for the whole extent (raises CRSError)
+    to_local.xy(
+        np.array([gx0, gx1, gx0, gx1, 0.5 * (gx0 + gx1)]), np.array([gy0, gy0, gy1, gy1, 0.5 * (gy0 + gy1)])
+    )
+    wall_min = (
+        cfg.wall_min if cfg.wall_min is not None else occluder_wall_min(res, math.radians(cfg.max_view_angle))
+    )
+    setup = prepare_views(
+        o,
+        surf,
+        to_local,
+        res,
+        cfg.max_view_angle,
+        cfg.visibility,
+        cfg.depth_tolerance,
+        cfg.zbuffer_oversample,
+        wall_min,
+        cfg.discontinuity,
+        cfg.edge_shift,
+    )
+    # ---- images that can contribute: on disk, one band count and dtype
+    ex_x, ex_y = to_local.xy(np.array([gx0, gx1, gx0, gx1]), np.array([gy0, gy0, gy1, gy1]))
+    b = setup.boxes
+    with np.errstate(invalid="ignore"):
+        relevant = np.flatnonzero(
+            (b[:, 0] <= ex_x.max())
+            & (b[:, 2] >= ex_x.min())
+            & (b[:, 1] <= ex_y.max())
+            & (b[:, 3] >= ex_y.min())
+        )
+    if not len(relevant):
+        raise InputError("EXTENT: no image of the orientation sees the extent")
+    paths = [str(o.resolve_image_path(im, image_root)) for im in o.images]
+    missing = [paths[i] for i in relevant if not os.path.isfile(paths[i])]
+    if missing:
+        more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+        raise MissingFileError(missing[0], f"image referenced by the orientation is absent{more}")
+    infos = {i: image_info(paths[i]) for i in relevant}
+    first = infos[relevant[0]]
+    for i in relevant:
+        inf = infos[i]
+        if inf.bands != first.bands or inf.dtype != first.dtype:
+            raise InputError(
+                f"{inf.path}: {inf.bands} band(s) of {inf.dtype}, but {first.path} has "
+                f"{first.bands} band(s) of {first.dtype}; all images of a mosaic must match"
+            )
+        cam = setup.cameras[i]
+        if (inf.width, inf.height) != (cam.width, cam.height):
+            raise InputError(
+                f"{inf.path}: image is {inf.width} x {inf.height} pixels but its camera "
+                f"{cam.id!r} is {cam.width} x {cam.height}"
+            )
+    # only relevant images are candidates
+    setup.boxes[np.setdiff1d(np.arange(len(o.images)), relevant)] = np.nan
+    bands, dtype = first.bands, np.dtype(first.dtype)
+    sizes = [(c.width, c.height) for c in setup.cameras]
+    store = ImageStore(paths, sizes, bands, dtype, cfg.image_cache_mb << 20)
+    params = MosaicParams(
+        cfg.edge_penalty, cfg.smoothness, cfg.contrast, cfg.discontinuity, cfg.blend_width, cfg.sweeps
+    )
+    workers = max(1, int(cfg.workers))
+    steps[0].update(1.0, f"true ortho: {grid.rows} x {grid.cols} cells of {res:g}, {len(relevant)} images")
+    stats: dict = {
+        "rows": grid.rows,
+        "cols": grid.cols,
+        "resolution": res,
+        "crs": out_crs,
+        "images_relevant": int(len(relevant)),
+        "bands": bands,
+        "dtype": dtype.name,
+        "visibility": cfg.visibility,
+        "margin_cells": setup.margin_cells,
+        "reprojected": not to_local.identity,
+    }
+    # ---- colour correction
+    correction = None
+    t0 = time.perf_counter()
+    if cfg.color_correction and len(relevant) > 1:
+        correction = _estimate_colour(
+            setup, surf, grid, to_local, store, cfg, steps[1], workers, len(o.images)
+        )
+        stats["color_correction"] = correction.as_dict([im.name for im in o.images])
+    stats["seconds_color"] = round(time.perf_counter() - t0, 3)
+    # ---- mosaic
+    t0 = time.perf_counter()
+    overlap = max(cfg.blend_width, 4) + 8
+    tiles = grid.tiles(cfg.tile_size, overlap)
+    sub = steps[2]
+    parts: dict[int, list] = {}
+    counts = np.zeros(len(o.images), np.int64)
+    n_seen = n_valid = n_occl = n_samples = 0
+    out_path = Path(os.fspath(output))
+    names = [f"band {k + 1}" for k in range(bands)] + ["alpha"]
+    amax = np.iinfo(dtype).max if dtype.kind in "ui" else 1.0
+    with contextlib.ExitStack() as stack:
+        from ..rasterio_io import RasterWriter
+
+        w_out = stack.enter_context(
+            RasterWriter(
+                out_path,
+                grid,
+                bands=bands + 1,
+                dtype=dtype,
+                nodata=None,
+                descriptions=names,
+                alpha=True,
+                overviews=True,
+                cog=cfg.cog,
+                photometric="RGB" if bands == 3 else "MINISBLACK",
+            )
+        )
+        w_idx = None
+        if source_index is not None:
+            w_idx = stack.enter_context(
+                RasterWriter(
+                    source_index,
+                    grid,
+                    1,
+                    "int16",
+                    nodata=-1,
+                    overviews=True,
+                    overview_resampling="nearest",
+                    cog=cfg.cog,
+                    descriptions=["source image index"],
+                )
+            )
+        w_occ = None
+        if occlusion is not None:
+            w_occ = stack.enter_context(
+                RasterWriter(
+                    occlusion,
+                    grid,
+                    1,
+                    "uint8",
+                    nodata=255,
+                    overviews=True,
+                    overview_resampling="nearest",
+                    cog=cfg.cog,
+                    descriptions=["1 = seen by no image"],
+                )
+            )
+        tri_max = 0
+        done: dict[tuple[int, int], tuple] = {}  # labels of the cores of the previous and current tile row
+        for n, tile in enumerate(tiles):
+            check(progress)
+            views = tile_views(setup, surf, grid, tile, to_local, workers)
+            tri_max = max(tri_max, views.triangles)
+            if len(views.cands):
+                isl = tile.inner_slices
+                n_samples += int(views.usable[:, isl[0], isl[1]].sum())
+            fixed = _fixed_labels(tile, done)
+            m = mosaic_tile(views, store, correction, res, params, fixed)
+            sl = tile.inner_slices
+            vals = to_dtype(m.values[:, sl[0], sl[1]], dtype)
+            alpha = m.alpha[sl]
+            vals[:, ~alpha] = 0
+            a = np.where(alpha, amax, 0).astype(dtype)
+            w_out.write(np.concatenate([vals, a[None]], axis=0), tile.core)
+            lab = m.label[sl]
+            done[tile.index] = (tile.core, lab.astype(np.int16))
+            for key in [k for k in done if k[0] < tile.index[0] - 1]:
+                del done[key]
+            if w_idx is not None:
+                w_idx.write(lab.astype(np.int16), tile.core)
+            if w_occ is not None:
+                w_occ.write(m.occlusion[sl], tile.core)
+            occ = m.occlusion[sl]
+            n_valid += int(np.count_nonzero(occ != 255))
+            n_occl += int(np.count_nonzero(occ == 1))
+            n_seen += int(np.count_nonzero(alpha))
+            ok = lab >= 0
+            counts += np.bincount(lab[ok], minlength=len(o.images))
+            for k, polys in region_polygons(lab, tile.core_grid(grid).transform).items():
+                parts.setdefault(k, []).extend(polys)
+            sub.update((n + 1) / len(tiles), f"tile {n + 1}/{len(tiles)}")
+        check(progress)
+        steps[3].update(0.0, "writing overviews")
+    stats["seconds_mosaic"] = round(time.perf_counter() - t0, 3)
+    regions = [SeamRegion(k, o.images[k].name, int(counts[k]), g) for k, g in dissolve(parts).items()]
+    stats.update(
+        {
+            "tiles": len(tiles),
+            "cells": grid.rows * grid.cols,
+            "cells_with_surface": n_valid,
+            "cells_textured": n_seen,
+            "cells_occluded": n_occl,
+            "coverage": round(n_seen / n_valid, 6) if n_valid else 0.0,
+            "images_used": int(np.count_nonzero(counts)),
+            "image_reads": store.reads,
+            "max_triangles_per_tile": int(tri_max),
+            "cell_image_samples": n_samples,
+            "seconds_total": round(time.perf_counter() - t_start, 3),
+        }
+    )
+    steps[3].update(1.0, "true orthophoto written")
+    prog.update(1.0, None)
+    return TrueOrthoResult(
+        out_path,
+        Path(source_index) if source_index else None,
+        Path(occlusion) if occlusion else None,
+        grid,
+        regions,
+        correction,
+        stats,
+    )
+
+
+def _fixed_labels(tile, done: dict) -> np.ndarray:
+    """Labels already written in the tile's outer window by earlier tiles (-1 elsewhere)."""
+    r0, c0, nr, nc = tile.outer
+    out = np.full((nr, nc), -1, np.int64)
+    for (cr0, cc0, cnr, cnc), lab in done.values():
+        a0, a1 = max(r0, cr0), min(r0 + nr, cr0 + cnr)
+        b0, b1 = max(c0, cc0), min(c0 + nc, cc0 + cnc)
+        if a1 > a0 and b1 > b0:
+            out[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0] = lab[a0 - cr0 : a1 - cr0, b0 - cc0 : b1 - cc0]
+    return out
+
+
+def _estimate_colour(
+    setup,
+    surf,
+    grid: RasterGrid,
+    to_local,
+    store: ImageStore,
+    cfg: TrueOrthoConfig,
+    progress,
+    workers: int,
+    n_images: int,
+) -> ColorCorrection:
+    """Corrections from a decimated copy of the output grid (cells seen cleanly by >= 2 images)."""
+    f = max(1, int(math.ceil(math.sqrt(grid.rows * grid.cols / max(cfg.color_cells, 1000)))))
+    g = grid.scaled(f)
+    # the depth margin is in cells of the grid used
+    import dataclasses
+
+    st = dataclasses.replace(setup, margin_cells=int(math.ceil(setup.margin_cells / f)) + 1)
+    tiles = g.tiles(cfg.tile_size, 0)
+    cells, imgs, vals = [], [], []
+    for n, tile in enumerate(tiles):
+        check(progress)
+        views = tile_views(st, surf, g, tile, to_local, workers)
+        if len(views.cands) >= 2:
+            clean = views.usable & ~views.near_edge & np.isfinite(views.heights)[None]
+            multi = clean.sum(axis=0) >= 2
+            need = clean & multi[None]
+            col = candidate_colours(views, store, None, g.res, need)
+            r0, c0 = tile.outer[0], tile.outer[1]
+            rr, cc = np.nonzero(multi)
+            cid = (rr + r0) * g.cols + (cc + c0)
+            for k in range(len(views.cands)):
+                mk = need[k][rr, cc]
+                if not mk.any():
+                    continue
+                v = col[k][rr[mk], cc[mk]]
+                good = np.all(np.isfinite(v), axis=1)
+                cells.append(cid[mk][good])
+                imgs.append(np.full(int(good.sum()), int(views.cands[k])))
+                vals.append(v[good])
+        progress.update((n + 1) / len(tiles), f"colour statistics {n + 1}/{len(tiles)}")
+    if not cells:
+        return ColorCorrection.identity(n_images, store.bands)
+    values = to_channels(np.concatenate(vals), store.dtype)
+    corr = estimate_corrections(np.concatenate(cells), np.concatenate(imgs), values, n_images)
+    corr.stats["grid_factor"] = f
+    return corr
+
+
+def check_output_paths(*paths) -> None:
+    """Raise InputError when two outputs share a path."""
+    seen = set()
+    for p in paths:
+        if p is None:
+            continue
+        k = os.path.abspath(os.fspath(p))
+        if k in seen:
+            raise InputError(f"output {p!r} is given twice")
+        seen.add(k)
+
+
+__all__ = ["SeamRegion", "TrueOrthoConfig", "TrueOrthoResult", "check_output_paths", "true_ortho"]

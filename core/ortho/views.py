@@ -1,0 +1,353 @@
+"""Per-tile visibility of the output cells in every image that may see them.
+
+For one tile (:class:`~truortho.core.grid.Tile`, computed on its outer window):
+
+1. the surface heights of the outer window plus a *margin* (cells outside the
+   tile that may occlude it: a cell at horizontal distance ``d`` from the window
+   can hide a window cell only if it stands more than ``d / tan(max_view_angle)``
+   above the window's lowest cell; the margin is the largest such ``d`` for the
+   surface's height range, and margin cells failing the test are left out of
+   the depth buffer);
+2. the candidate images: those whose footprint (the frame cast onto the
+   planes of the lowest and highest surface height) meets the window;
+3. per candidate: a depth buffer over the image window the tile's cells project
+   into, at ``scale = min(1, oversample * gsd / res)`` buffer pixels per image
+   pixel (so a buffer pixel is the image pixel or, for a coarse output, about
+   one output cell), and the depth test of every cell (:mod:`.zbuffer`);
+4. per candidate and cell: viewing angle, incidence on the surface (normal from
+   the heights, the smaller one-sided difference on each axis so a cell next to
+   a wall keeps the slope of its own roof or ground) and the effective ground
+   resolution of :mod:`.select`.
+
+Cells are usable in an image when visible, in front of the surface (incidence
+below 90 degrees) and seen at most ``max_view_angle`` off nadir. Without
+visibility (``visibility=False``, the conventional orthorectification) a cell
+is usable in every image whose frame contains its projection.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.camera import Camera
+from ..grid import RasterGrid, Tile
+from .surface import PlanTransform
+from .zbuffer import frame_cells, render_depth, view_cells
+
+
+@dataclass
+class ViewSetup:
+    """What every tile needs, prepared once (:func:`prepare_views`)."""
+
+    images: list  # orientation Image objects (all of the orientation)
+    cameras: list[Camera]  # camera of each image
+    boxes: np.ndarray  # (n, 4) local xy bounding boxes of the footprints
+    zmin: float  # local heights
+    zmax: float
+    max_view: float  # radians
+    margin_cells: int
+    visibility: bool
+    tol_factor: float
+    oversample: float
+    wall_min: float
+    discontinuity: float = 1.0  # height step (m) of a building outline for the edge shift
+    edge_shift: float = 0.75  # cells
+
+
+def image_boxes(images, cameras, zmin: float, zmax: float) -> np.ndarray:
+    """Local plan bounding boxes (n, 4) of every image's footprint between heights zmin and zmax.
+
+    The frame outline (8 samples per edge) is cast onto both planes; rays above
+    the horizon are cut at 20 times the height above the plane (as
+    :func:`~truortho.core.geometry.footprint.footprint_on_plane`). NaN rows: the
+    image sees neither plane.
+    """
+    from ..geometry.camera import undistort_points
+    from ..geometry.footprint import frame_outline
+
+    rays: dict[int, np.ndarray] = {}
+    out = np.full((len(images), 4), np.nan)
+    for k, (im, cam) in enumerate(zip(images, cameras, strict=True)):
+        key = id(cam)
+        if key not in rays:
+            xy = undistort_points(frame_outline(cam, 8), cam)
+            rays[key] = np.column_stack([xy, np.ones(len(xy))])[np.all(np.isfinite(xy), axis=1)]
+        d = rays[key] @ im.R  # R^T d_cam, row-wise
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        pts = []
+        for z in (zmin, zmax):
+            hgt = im.C[2] - z
+            reach = 20.0 * max(abs(hgt), 1.0)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                t = (z - im.C[2]) / d[:, 2]
+            hit = t > 0
+            horiz = d[:, :2] / np.maximum(np.linalg.norm(d[:, :2], axis=1, keepdims=True), 1e-12)
+            p = np.where(hit[:, None], d[:, :2] * np.where(hit, t, 0.0)[:, None], horiz * reach)
+            r = np.linalg.norm(p, axis=1, keepdims=True)
+            p = np.where(r > reach, p / np.maximum(r, 1e-12) * reach, p)
+            if hit.any():
+                pts.append(p + im.C[:2])
+        if pts:
+            q = np.vstack(pts)
+            out[k] = [q[:, 0].min(), q[:, 1].min(), q[:, 0].max(), q[:, 1].max()]
+    return out
+
+
+def prepare_views(
+    orientation,
+    surface,
+    to_local: PlanTransform,
+    res: float,
+    max_view_deg: float,
+    visibility: bool,
+    tol_factor: float,
+    oversample: float,
+    wall_min: float,
+    discontinuity: float = 0.5,
+    edge_shift: float = 0.75,
+    max_margin_cells: int = 1024,
+) -> ViewSetup:
+    images = list(orientation.images)
+    cams = [orientation.camera_of(im) for im in images]
+    lo, hi = surface.height_range()
+    zmin, zmax = lo - to_local.offset[2], hi - to_local.offset[2]
+    max_view = math.radians(max_view_deg)
+    margin = 0
+    if visibility:
+        margin = int(math.ceil((zmax - zmin) * math.tan(max_view) / res)) + 2
+        margin = min(margin, max_margin_cells)
+    boxes = image_boxes(images, cams, zmin, zmax)
+    return ViewSetup(
+        images,
+        cams,
+        boxes,
+        zmin,
+        zmax,
+        max_view,
+        margin,
+        visibility,
+        tol_factor,
+        oversample,
+        wall_min,
+        max(float(discontinuity), 2.0 * res),
+        float(edge_shift),
+    )
+
+
+@dataclass
+class TileViews:
+    """Visibility of the outer-window cells of one tile in its candidate images.
+
+    Attributes
+    ----------
+    grid : RasterGrid
+        The outer window.
+    heights : (rows, cols) float64, world heights (NaN = no surface)
+    cands : (K,) int, indices into the orientation's images
+    usable, near_edge : (K, rows, cols) bool
+    uv : (K, rows, cols, 2) float32 full-resolution pixel coordinates
+    eff_res : (K, rows, cols) float32 effective ground resolution (metres)
+    gsd : (K,) float, median pixel footprint (metres) of each candidate over the tile
+    """
+
+    grid: RasterGrid
+    heights: np.ndarray
+    cands: np.ndarray
+    usable: np.ndarray
+    near_edge: np.ndarray
+    uv: np.ndarray
+    eff_res: np.ndarray
+    gsd: np.ndarray
+    triangles: int = 0
+
+
+def _normals(h: np.ndarray, res: float) -> np.ndarray:
+    """Unit normals (rows, cols, 3) from the smaller one-sided differences."""
+    hz = np.where(np.isfinite(h), h, np.nan)
+
+    def d(axis):
+        fwd = np.diff(hz, axis=axis, append=np.nan)
+        bwd = np.diff(hz, axis=axis, prepend=np.nan)
+        a = np.where(np.isnan(fwd), bwd, fwd)
+        b = np.where(np.isnan(bwd), fwd, bwd)
+        out = np.where(np.abs(a) <= np.abs(b), a, b)
+        return np.where(np.isfinite(out), out, 0.0) / res
+
+    dzdx = d(1)
+    dzdy = -d(0)  # rows go south
+    n = np.stack([-dzdx, -dzdy, np.ones_like(dzdx)], axis=-1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def edge_shift(h: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
+    """Unit plan vectors (rows, cols) ``(dx, dy)`` pointing away from neighbouring height discontinuities.
+
+    A cell whose 4-neighbour differs in height by more than ``step`` gets the
+    (normalised) sum of the unit vectors from such neighbours towards itself;
+    other cells get 0. x is east, y north.
+    """
+    hz = np.where(np.isfinite(h), h, np.nan)
+    dx = np.zeros(h.shape)
+    dy = np.zeros(h.shape)
+    with np.errstate(invalid="ignore"):
+        jump_e = np.zeros(h.shape, bool)
+        jump_e[:, :-1] = ~(np.abs(hz[:, 1:] - hz[:, :-1]) <= step)  # neighbour to the east differs
+        jump_w = np.zeros(h.shape, bool)
+        jump_w[:, 1:] = jump_e[:, :-1]
+        jump_s = np.zeros(h.shape, bool)
+        jump_s[:-1, :] = ~(np.abs(hz[1:, :] - hz[:-1, :]) <= step)  # neighbour to the south (next row)
+        jump_n = np.zeros(h.shape, bool)
+        jump_n[1:, :] = jump_s[:-1, :]
+    dx -= jump_e
+    dx += jump_w
+    dy += jump_s
+    dy -= jump_n
+    n = np.hypot(dx, dy)
+    ok = n > 0
+    dx[ok] /= n[ok]
+    dy[ok] /= n[ok]
+    return dx, dy
+
+
+def tile_views(
+    setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local: PlanTransform, workers: int = 1
+) -> TileViews:
+    """Visibility and view quality of the outer window of ``tile`` (module docstring)."""
+    res = grid.res
+    outer = tile.outer_grid(grid)
+    M = setup.margin_cells
+    region = grid.window(tile.outer[0] - M, tile.outer[1] - M, tile.outer[2] + 2 * M, tile.outer[3] + 2 * M)
+    hreg = surface.heights_on(region)
+    h = hreg[M : M + outer.rows, M : M + outer.cols]
+    rows, cols = h.shape
+    valid = np.isfinite(h)
+    X, Y = outer.centres()
+    lx, ly = to_local.xy(X, Y)
+    lz = h - to_local.offset[2]
+    P = np.column_stack([lx.ravel(), ly.ravel(), np.where(valid, lz, 0.0).ravel()])
+    vflat = valid.ravel()
+    empty = TileViews(
+        outer,
+        h,
+        np.zeros(0, np.int64),
+        np.zeros((0, rows, cols), bool),
+        np.zeros((0, rows, cols), bool),
+        np.zeros((0, rows, cols, 2), np.float32),
+        np.zeros((0, rows, cols), np.float32),
+        np.zeros(0),
+    )
+    if not vflat.any():
+        return empty
+    bx0, by0 = float(lx[valid].min()), float(ly[valid].min())
+    bx1, by1 = float(lx[valid].max()), float(ly[valid].max())
+    b = setup.boxes
+    with np.errstate(invalid="ignore"):
+        hit = (b[:, 0] <= bx1) & (b[:, 2] >= bx0) & (b[:, 1] <= by1) & (b[:, 3] >= by0)
+    cand_all = np.flatnonzero(hit)
+    if not len(cand_all):
+        return empty
+    tris = None
+    if setup.visibility:
+        zlow = float(np.nanmin(h))
+        rr, cc = np.mgrid[0 : region.rows, 0 : region.cols]
+        dr = np.maximum(np.maximum(M - rr, rr - (M + rows - 1)), 0)
+        dc = np.maximum(np.maximum(M - cc, cc - (M + cols - 1)), 0)
+        dist = np.hypot(dr, dc) * res
+        with np.errstate(invalid="ignore"):
+            include = (dist == 0) | (hreg - zlow > dist / math.tan(setup.max_view) - res)
+        tris = surface.triangles(region, hreg, include, to_local, setup.wall_min)
+    normals3 = _normals(h, res)
+    normals = np.ascontiguousarray(normals3.reshape(-1, 3))
+    # colour sample points: cells next to a height discontinuity are sampled a little inside their own
+    # side, so the bilinear sample does not mix in the other side of a building outline
+    S = P
+    if setup.edge_shift > 0:
+        ex, ey = edge_shift(h, setup.discontinuity)
+        moved = (ex != 0) | (ey != 0)
+        if moved.any():
+            delta = setup.edge_shift * res
+            sx, sy = X + delta * ex, Y + delta * ey
+            slx, sly = to_local.xy(sx[moved], sy[moved])
+            # height along the cell's own slope
+            nz = normals3[..., 2][moved]
+            sz = (
+                lz[moved]
+                - delta * (normals3[..., 0][moved] * ex[moved] + normals3[..., 1][moved] * ey[moved]) / nz
+            )
+            S = P.copy()
+            mi = np.flatnonzero(moved.ravel())
+            S[mi, 0], S[mi, 1], S[mi, 2] = slx, sly, sz
+
+    vidx = np.flatnonzero(vflat)
+    Pv = np.ascontiguousarray(P[vidx])
+
+    def one(k):
+        im = setup.images[k]
+        cam = setup.cameras[k]
+        sub, uvp, dist = frame_cells(Pv, im.R, im.C, cam, setup.max_view)
+        if not len(sub):
+            return None
+        idx = vidx[sub]
+        gsd = float(np.median(dist)) / cam.fx
+        scale = min(1.0, setup.oversample * gsd / res) if setup.visibility else 1.0
+        zb = win = None
+        if setup.visibility:
+            uvb = (uvp + 0.5) * scale - 0.5
+            bw = max(1, int(round(cam.width * scale)))
+            bh = max(1, int(round(cam.height * scale)))
+            x0 = max(int(math.floor(uvb[:, 0].min())) - 2, 0)
+            y0 = max(int(math.floor(uvb[:, 1].min())) - 2, 0)
+            x1 = min(int(math.ceil(uvb[:, 0].max())) + 2, bw - 1)
+            y1 = min(int(math.ceil(uvb[:, 1].max())) + 2, bh - 1)
+            win = (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
+            zb = render_depth(tris, im.R, im.C, cam, win, scale)
+        # one fused pass: depth test, near-occluder test, incidence, effective resolution, sample
+        # coordinates (the nearest pixel next to an occluder instead of a bilinear mix with it)
+        good, ne, uvk, eff = view_cells(
+            idx,
+            P,
+            S,
+            normals,
+            im.R,
+            im.C,
+            cam,
+            zb,
+            win,
+            scale,
+            res,
+            setup.tol_factor,
+            setup.visibility,
+        )
+        return idx[good], ne[good], uvk[good], eff[good], gsd
+
+    if workers > 1 and len(cand_all) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(max_workers=workers) as pool:
+            results = list(pool.map(one, cand_all))
+    else:
+        results = [one(k) for k in cand_all]
+    keep = [i for i, r in enumerate(results) if r is not None and len(r[0])]
+    if not keep:
+        return empty
+    K = len(keep)
+    n = rows * cols
+    usable = np.zeros((K, n), bool)
+    edge = np.zeros((K, n), bool)
+    uv = np.full((K, n, 2), np.nan, np.float32)
+    eff = np.full((K, n), np.inf, np.float32)
+    for k, i in enumerate(keep):
+        gi, ne, uvk, ek, _ = results[i]
+        usable[k, gi] = True
+        edge[k, gi] = ne
+        uv[k, gi] = uvk
+        eff[k, gi] = ek
+    usable = usable.reshape(K, rows, cols)
+    edge = edge.reshape(K, rows, cols)
+    uv = uv.reshape(K, rows, cols, 2)
+    eff = eff.reshape(K, rows, cols)
+    gsd = np.array([results[i][4] for i in keep])
+    return TileViews(outer, h, cand_all[keep], usable, edge, uv, eff, gsd, 0 if tris is None else len(tris))

@@ -1,0 +1,61 @@
+"""Colour model and least-squares corrections (core/ortho/color.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from truortho.core.ortho.color import (
+    ColorCorrection,
+    estimate_corrections,
+    from_channels,
+    lab_to_rgb,
+    rgb_to_lab,
+    to_channels,
+)
+from truortho.core.synthetic import srgb_to_lab
+
+
+def test_lab_matches_the_generator_and_round_trips():
+    rgb = np.random.default_rng(0).uniform(0, 1, (500, 3))
+    assert np.allclose(rgb_to_lab(rgb), srgb_to_lab(rgb), atol=1e-9)
+    assert np.allclose(lab_to_rgb(rgb_to_lab(rgb)), rgb, atol=1e-6)
+    u16 = (rgb * 65535).round()
+    assert np.allclose(from_channels(to_channels(u16, "uint16"), "uint16"), u16, atol=0.05)
+
+
+def test_estimate_recovers_relative_gains_with_outliers():
+    rng = np.random.default_rng(1)
+    n_img, n_cell = 6, 3000
+    g_true = rng.uniform(0.8, 1.2, (n_img, 2))
+    g_true /= g_true.mean(axis=0)
+    o_true = rng.normal(0, 3, (n_img, 2))
+    o_true -= o_true.mean(axis=0)
+    x = rng.uniform(10, 90, (n_cell, 2))
+    cells, imgs, vals = [], [], []
+    for c in range(n_cell):
+        for i in rng.choice(n_img, size=rng.integers(2, 5), replace=False):
+            # observed = inverse of the correction applied to the common truth
+            y = (x[c] - o_true[i]) / g_true[i] + rng.normal(0, 0.2, 2)
+            if rng.random() < 0.03:
+                y = y + rng.normal(0, 40, 2)  # occlusion error, moving object
+            cells.append(c)
+            imgs.append(i)
+            vals.append(y)
+    corr = estimate_corrections(np.array(cells), np.array(imgs), np.array(vals), n_img)
+    assert np.allclose(corr.gain, g_true, atol=0.01)
+    assert np.allclose(corr.offset, o_true, atol=0.6)
+    assert all(
+        a < 0.3 * b for a, b in zip(corr.stats["median_after"], corr.stats["median_before"], strict=True)
+    )
+    assert np.allclose(corr.gain.mean(axis=0), 1.0, atol=1e-3) and np.allclose(
+        corr.offset.mean(axis=0), 0, atol=1e-2
+    )
+
+
+def test_apply_keeps_the_range_of_the_dtype():
+    c = ColorCorrection(np.array([[1.5, 1.0, 1.0]]), np.array([[10.0, 0.0, 0.0]]), True)
+    s = np.array([[250.0, 250.0, 250.0], [0.0, 0.0, 0.0]])
+    out = c.apply(0, s, "uint8")
+    assert out.min() >= 0 and out.max() <= 255 and out[0, 0] == pytest.approx(255)
+    assert ColorCorrection.identity(2, 1).apply(1, s[:, :1], "float32") is not None

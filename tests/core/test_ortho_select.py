@@ -1,0 +1,82 @@
+"""Selection energy, ICM and feathering (core/ortho/select.py, seams.py) against references."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from truortho.core.ortho.seams import feather_weights
+from truortho.core.ortho.select import edge_weights, initial_labels, select_labels
+
+
+def _energy(labels, cost, lum, h, h0, smooth, contrast):
+    """Obvious-but-slow energy of a labelling (same definition as the module docstring)."""
+    wh, wv = edge_weights(h, h0)
+    rows, cols = labels.shape
+    e = 0.0
+    for r in range(rows):
+        for c in range(cols):
+            a = labels[r, c]
+            if a < 0:
+                continue
+            e += cost[a, r, c]
+            for dr, dc, w in (
+                (0, 1, wh[r, c] if c < cols - 1 else 0),
+                (1, 0, wv[r, c] if r < rows - 1 else 0),
+            ):
+                rr, cc = r + dr, c + dc
+                if rr >= rows or cc >= cols or labels[rr, cc] < 0 or labels[rr, cc] == a:
+                    continue
+                b = labels[rr, cc]
+                d = 0.0
+                for p in ((r, c), (rr, cc)):
+                    la, lb = lum[a][p], lum[b][p]
+                    d += abs(la - lb) if np.isfinite(la) and np.isfinite(lb) else 1.0
+                e += smooth * w * (1 + contrast * d)
+    return e
+
+
+def test_icm_lowers_the_energy_and_keeps_fixed_labels():
+    rng = np.random.default_rng(5)
+    K, R, C = 4, 24, 30
+    cost = rng.uniform(0, 1, (K, R, C)).astype(np.float32)
+    cost[rng.uniform(size=cost.shape) < 0.25] = np.inf
+    cost[0, :, :] = np.where(np.isfinite(cost[0]), cost[0], 0.5)  # every cell seen by image 0
+    lum = rng.uniform(0, 1, (K, R, C)).astype(np.float32)
+    lum[~np.isfinite(cost)] = np.nan
+    h = np.zeros((R, C))
+    h[5:15, 8:20] = 6.0  # a building
+    res = 0.25
+    h0 = max(0.5, 2 * res)
+    start = initial_labels(cost, h, h0, 10_000)
+    fixed = np.full((R, C), -1, np.int32)
+    fixed[:, 0] = 0
+    out = select_labels(cost, h, lum, res, smoothness=1.0, contrast=4.0, fixed=fixed)
+    assert np.all(out[:, 0] == 0)
+    assert np.all(np.isfinite(np.take_along_axis(cost, out[None].astype(np.int64), 0)[0]))
+    e0 = _energy(start, cost, lum, h, h0, 1.0, 4.0)
+    e1 = _energy(out, cost, lum, h, h0, 1.0, 4.0)
+    assert e1 < e0
+
+
+def test_roof_segment_gets_one_image():
+    K, R, C = 3, 40, 40
+    cost = np.random.default_rng(1).uniform(0, 0.3, (K, R, C)).astype(np.float32)
+    h = np.zeros((R, C))
+    h[10:30, 12:28] = 8.0
+    lab = select_labels(cost, h, None, 0.25)
+    roof = lab[10:30, 12:28]
+    assert len(np.unique(roof)) == 1
+
+
+def test_feather_weights_sum_to_one_and_respect_visibility():
+    R, C = 20, 30
+    labels = np.zeros((R, C), np.int64)
+    labels[:, 15:] = 1
+    clean = np.ones((2, R, C), bool)
+    clean[1, :, :10] = False  # image 1 does not see the west part
+    w = feather_weights(labels, clean, 5)
+    assert np.allclose(w.sum(axis=0), 1.0)
+    assert np.all(w[1][:, :10] == 0)
+    ramp = w[1][10]
+    assert ramp[12] == 0 and 0 < ramp[14] < ramp[15] < ramp[16] < 1 and ramp[18] == 1
+    assert np.all(feather_weights(labels, clean, 0)[1] == (labels == 1))

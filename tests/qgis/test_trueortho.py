@@ -1,0 +1,106 @@
+"""truortho:trueortho through processing.run on a small synthetic scene."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+pytestmark = pytest.mark.qgis
+
+
+@pytest.fixture(scope="module")
+def scene_dir(tmp_path_factory):
+    from truortho.core.synthetic import SceneConfig, make_scene
+
+    scene = make_scene(SceneConfig(image_size=(240, 180), focal_px=300.0, n_buildings=4, n_oblique=2, seed=5))
+    root = tmp_path_factory.mktemp("trueortho")
+    scene.write(root)
+    return scene, root
+
+
+def run(params):
+    import processing
+
+    return processing.run("truortho:trueortho", params)
+
+
+def test_trueortho_outputs(truortho_provider, scene_dir, tmp_path):
+    from qgis.core import QgsRasterLayer, QgsVectorLayer
+
+    from truortho.core.rasterio_io import read_raster
+
+    scene, root = scene_dir
+    res = run(
+        {
+            "ORIENTATION": str(root / "orientation.json"),
+            "SURFACE": str(root / "dsm.tif"),
+            "BLEND_WIDTH": 3,
+            "OUTPUT": str(tmp_path / "ortho.tif"),
+            "SOURCE_INDEX": str(tmp_path / "idx.tif"),
+            "OCCLUSION": str(tmp_path / "occ.tif"),
+            "SEAMLINES": str(tmp_path / "seams.gpkg"),
+        }
+    )
+    ortho = QgsRasterLayer(res["OUTPUT"], "o")
+    assert ortho.isValid() and ortho.bandCount() == 4 and ortho.crs().authid() == "EPSG:32632"
+    idx, _, _ = read_raster(res["SOURCE_INDEX"])
+    seams = QgsVectorLayer(res["SEAMLINES"], "s", "ogr")
+    assert seams.featureCount() == len(np.unique(idx[idx >= 0]))
+    total = sum(f["cells"] for f in seams.getFeatures())
+    assert total == int((idx >= 0).sum())
+    names = {f["image"] for f in seams.getFeatures()}
+    assert names <= {im.name for im in scene.orientation.images}
+    a, _, _ = read_raster(res["OUTPUT"], band=4)
+    assert (a > 0).mean() > 0.95
+
+
+def test_trueortho_extent_and_crs(truortho_provider, scene_dir, tmp_path):
+    from qgis.core import QgsRasterLayer
+
+    scene, root = scene_dir
+    x0, y0, x1, y1 = scene.extent_world()
+    res = run(
+        {
+            "ORIENTATION": str(root / "orientation.json"),
+            "SURFACE": str(root / "dsm.tif"),
+            "EXTENT": f"{x0 + 10},{x0 + 50},{y0 + 10},{y0 + 40} [EPSG:32632]",
+            "RESOLUTION": 0.5,
+            "CRS": "EPSG:25832",
+            "COLOR_CORRECTION": False,
+            "OUTPUT": str(tmp_path / "o25832.tif"),
+        }
+    )
+    lyr = QgsRasterLayer(res["OUTPUT"], "o")
+    assert lyr.crs().authid() == "EPSG:25832"
+    assert lyr.width() == pytest.approx(80, abs=2) and lyr.height() == pytest.approx(60, abs=2)
+
+
+def test_trueortho_bad_input(truortho_provider, scene_dir, tmp_path):
+    from qgis.core import QgsProcessingException
+
+    from truortho.core.orientation import Orientation
+
+    scene, root = scene_dir
+    x0, y0, x1, y1 = scene.extent_world()
+    with pytest.raises(QgsProcessingException, match="SURFACE"):
+        run(
+            {
+                "ORIENTATION": str(root / "orientation.json"),
+                "SURFACE": str(root / "dsm.tif"),
+                "EXTENT": f"{x0 - 100},{x1},{y0},{y1} [EPSG:32632]",
+                "OUTPUT": str(tmp_path / "bad.tif"),
+            }
+        )
+    o = Orientation.load(root / "orientation.json")
+    dataclasses.replace(o, image_root=str(tmp_path / "gone")).save(tmp_path / "moved.json")
+    with pytest.raises(QgsProcessingException, match="absent"):
+        run(
+            {
+                "ORIENTATION": str(tmp_path / "moved.json"),
+                "SURFACE": str(root / "dsm.tif"),
+                "OUTPUT": str(tmp_path / "bad2.tif"),
+            }
+        )
+    assert not list(tmp_path.glob("bad*"))
