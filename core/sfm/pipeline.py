@@ -18,6 +18,7 @@ Stages (each reports progress and honours cancel):
 
 from __future__ import annotations
 
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -58,7 +59,8 @@ class OrientConfig:
     #: Intrinsics estimated by self-calibration (subset of f, cx, cy, k1, k2, k3, p1, p2); with a
     #: given interior orientation file and this default, only ``f`` is refined (the file is a calibration).
     refine_intrinsics: tuple[str, ...] = ALL_INTRINSICS
-    #: Tie-point decimation grid cell, pixels at full resolution (None: max(w, h) / 50).
+    #: Tie-point decimation grid cell, pixels at full resolution (None: from the block size, see
+    #: :func:`decimation_cell`).
     decimation_cell_px: float | None = None
     #: Every image pair keeps at least this many of its shared tie points through the decimation
     #: (the links of weakly connected images; see :func:`~.tracks.decimate_tracks`).
@@ -208,6 +210,25 @@ def _gps_local(exifs, crs_text_, warnings):
     return xyz, crs_text_
 
 
+#: Decimation keeps about this many grid cells per image in total over the block ...
+TIE_CELL_BUDGET = 150_000
+#: ... but never fewer than the first or more than the second per image.
+TIE_CELLS_PER_IMAGE = (2500, 10000)
+
+
+def decimation_cell(max_size_px: float, n_images: int) -> float:
+    """Grid cell (pixels) of the tie-point decimation for a block of ``n_images``.
+
+    Decimation bounds the adjustment's size on large blocks; small blocks can afford more
+    tie points, which makes their orientation more precise. The grid has
+    ``clip(TIE_CELL_BUDGET / n_images, *TIE_CELLS_PER_IMAGE)`` cells per image (50 x 50 cells
+    for 60 images or more, 100 x 100 for 15 or fewer), and a cell is never smaller than 8 px.
+    """
+    lo, hi = TIE_CELLS_PER_IMAGE
+    cells = min(hi, max(lo, TIE_CELL_BUDGET / max(int(n_images), 1)))
+    return max(float(max_size_px) / math.sqrt(cells), 8.0)
+
+
 def orient_images(
     paths,
     camera_file=None,
@@ -288,7 +309,7 @@ def orient_images(
         )
 
     t = time.perf_counter()
-    cell = cfg.decimation_cell_px or max(float(sizes.max()) / 50.0, 8.0)
+    cell = cfg.decimation_cell_px or decimation_cell(float(sizes.max()), len(paths))
     tracks = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)
     steps[3].update(1.0, f"{tracks.n_tracks} tie points after decimation")
     times["tracks"] = time.perf_counter() - t
@@ -297,8 +318,8 @@ def orient_images(
     inc = cfg.incremental
     refine = tuple(cfg.refine_intrinsics)
     if camera_file and refine == ALL_INTRINSICS:
-        # a given interior orientation is taken as calibrated: only the focal length follows the block
-        refine = ("f",)
+        # a given interior orientation is a calibration: kept fixed unless a subset is asked for
+        refine = ()
     inc.refine_intrinsics = refine
     if not cfg.self_calibration:
         inc.refine_intrinsics = ()

@@ -86,8 +86,8 @@ HELP: dict[str, dict] = {
             "IMAGES": "Folder of the images (non-image files are skipped with a warning in the report).",
             "IMAGE_FILES": "The image files, instead of a folder.",
             "CAMERA": "Interior orientation: an Orthority interior file (YAML/JSON) or a text file with the "
-            "3x3 matrix K. Without it: EXIF focal length and sensor size, else f = 1.2 x max(w, h); "
-            "refined by self-calibration.",
+            "3x3 matrix K, taken as a calibration and held fixed. Without it: EXIF focal length and sensor "
+            "size, else f = 1.2 x max(w, h), refined by self-calibration.",
             "GCPS": "Ground control and check points: point layer with 'name', 'role' (gcp|check), PointZ or "
             "'z', optional 'sigma_xy'/'sigma_z' (metres). Reprojected to CRS.",
             "OBSERVATIONS": "Image measurements of the GCPs: table with 'gcp', 'image' (file name), 'x', 'y' "
@@ -96,8 +96,8 @@ HELP: dict[str, dict] = {
             "positions).",
             "WORKING_SIZE": "Larger image side at which features are detected, pixels.",
             "MAX_FEATURES": "Features kept per image.",
-            "SELF_CALIBRATION": "Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment (else hold the "
-            "interior orientation).",
+            "SELF_CALIBRATION": "Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment when no CAMERA file is "
+            "given (else hold the prior interior orientation).",
             "ORIENTATION": "The adjusted orientation (TruOrtho JSON).",
             "REPORT": "HTML report (and a JSON file of the same name): sigma0, image RMS, per-image "
             "residuals, GCP and check point tables, residual vector plots, tie-point multiplicity "
