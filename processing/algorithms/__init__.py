@@ -12,6 +12,7 @@ from .importgcps import ImportGcpsAlgorithm
 from .importorientation import ImportOrientationAlgorithm
 from .mesh import MeshAlgorithm
 from .orientimages import OrientImagesAlgorithm
+from .osgm import OsgmAlgorithm
 from .pointcloud import DsmToPointCloudAlgorithm, MergePointCloudsAlgorithm
 from .trueortho import TrueOrthoAlgorithm
 
@@ -21,6 +22,7 @@ ALGORITHMS: list[type] = [
     ExportOrientationAlgorithm,
     ImportGcpsAlgorithm,
     OrientImagesAlgorithm,
+    OsgmAlgorithm,
     TrueOrthoAlgorithm,
     DsmFilterAlgorithm,
     MeshAlgorithm,

@@ -108,6 +108,63 @@ HELP: dict[str, dict] = {
             "surveyed).",
         },
     },
+    "osgm": {
+        "summary": (
+            "Dense image matching in object space (OSGM): computes a DSM directly on a ground grid from "
+            "the oriented images, without rectification or pairwise depth maps. For every tile of the grid "
+            "the images that see it (at most MAX_IMAGES) are resampled onto the horizontal plane of every "
+            "search height (voxels of RESOLUTION x RESOLUTION x Z_STEP); a matching cost from all of them "
+            "per cell and height is aggregated by semi-global matching along 8 or 16 paths (penalty P1 for "
+            "a change of one height step, P2 for larger jumps, lowered across image edges), and each cell "
+            "takes the height of least aggregated cost, refined between steps, with a confidence in "
+            "[0, 1]. Matching runs coarse to fine over an image pyramid, by tiles, with progress and cancel. "
+            "Cells without a reliable match are nodata (filter and fill them with truortho:dsmfilter). "
+            "Optionally writes the confidence, an orthoimage coloured from the matched images, and a point "
+            "cloud; with OBLIQUE = auto, groups of oblique images are matched in extra reference systems "
+            "along their viewing directions, whose points (facades) go to the point cloud."
+        ),
+        "parameters": {
+            "ORIENTATION": "Orientation JSON (from Orient images or Import orientation) with a projected "
+            "CRS (metres) and at least two images, which must be on disk.",
+            "EXTENT": "Area to match (reprojected to the orientation's CRS); default the extent of the "
+            "sparse points (1-99 %), else the union of the near-nadir image footprints. It must intersect "
+            "the area the images see.",
+            "RESOLUTION": "Cell size of the DSM, metres; empty or 0 = the median ground sample distance of "
+            "the near-nadir images.",
+            "Z_STEP": "Height step between two search planes, metres; empty or 0 = the resolution.",
+            "Z_MIN": "Lowest height searched (world Z, the orientation's vertical datum); empty = from the "
+            "sparse points (0.5 % percentile minus a margin), else from the GCP heights. Must be below "
+            "Z_MAX.",
+            "Z_MAX": "Highest height searched; empty = from the sparse points (99.5 % percentile plus a "
+            "margin), else half the flying height above the highest GCP. Always kept below the cameras. "
+            "Without sparse points or GCPs give Z_MIN and Z_MAX.",
+            "Z_SURFACE": "Optional coarse DSM or DTM raster: the search at each cell is bounded by the "
+            "lowest and highest height of its neighbourhood plus a margin, which speeds up matching and "
+            "avoids wrong heights on rough terrain.",
+            "PATHS": "Number of aggregation directions of semi-global matching: 8 (faster) or 16 (smoother "
+            "slanted surfaces).",
+            "OBLIQUE": "none: one nadir reference system (the DSM). auto: groups of oblique images also get "
+            "reference systems along their viewing directions, whose points go to the point cloud with "
+            "their 'system' id.",
+            "P1": "Penalty for a change of one height step between neighbouring cells, in cost units "
+            "(unrelated image windows cost 1023); empty = 256.",
+            "P2": "Penalty for a larger height jump, above P1 and at most 3072; empty = 2048 (a jump then "
+            "needs contrary evidence from two cells).",
+            "MAX_IMAGES": "Largest number of images matched per tile (best coverage first, then the most "
+            "nadir); memory and time grow with it.",
+            "TILE_SIZE": "Tile side in cells; memory grows with its square, the number of search heights "
+            "and MAX_IMAGES.",
+            "DSM": "The raw DSM: GeoTIFF, float32, in the orientation's CRS, nodata -9999.",
+            "CONFIDENCE": "Optional confidence GeoTIFF (float32 in [0, 1], nodata -1) on the DSM grid, for "
+            "truortho:dsmfilter.",
+            "ORTHOIMAGE": "Optional RGB orthoimage GeoTIFF (uint8, 0 = no data) on the DSM grid, coloured "
+            "from the matched images; not a true orthophoto (use truortho:trueortho for that).",
+            "POINT_CLOUD": "Optional point cloud (.laz or .las; LAS 1.4 with colours, 'confidence' and "
+            "'system', the reference system of each point).",
+            "STATISTICS": "JSON: grid size, resolution, height step and range (and where it came from), "
+            "pyramid levels, tiles, completeness, mean confidence, reference systems, time.",
+        },
+    },
     "trueortho": {
         "summary": (
             "Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, "
