@@ -1,0 +1,140 @@
+"""The coarse-to-fine plan of OSGM: pyramid levels and per-cell Z windows.
+
+Level ``l`` has cells ``2^l`` times the resolution and Z steps ``2^l dZ``
+(the voxel stays proportioned). The coarsest level is chosen so that the
+whole Z range needs at most :data:`COARSE_LEVELS` steps there (and at least
+two halvings, as long as the coarse grid keeps :data:`MIN_COARSE_CELLS`
+cells across), so its full-range search is cheap.
+
+On every finer level a cell searches only the band between the lowest and
+the highest coarse result of its 3 x 3 coarse neighbourhood, widened by
+:data:`MARGIN_STEPS` coarse steps: a cell at a building outline keeps both the
+ground and the roof in its band. Where the coarse level has no result
+(rejected as ambiguous), the band comes from a 7 x 7 neighbourhood, else from
+the tile's range, else the whole range. Bands wider than :data:`MAX_BAND`
+levels are cut around the coarse value of the cell.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..grid import RasterGrid
+
+#: Z steps the coarsest level may need for the whole range.
+COARSE_LEVELS = 64
+#: Smallest side of the coarsest grid, cells.
+MIN_COARSE_CELLS = 16
+#: Coarse steps added above and below the coarse neighbourhood's range.
+MARGIN_STEPS = 3
+#: Widest band of levels a cell searches on a refined level.
+MAX_BAND = 192
+
+
+@dataclass
+class LevelPlan:
+    z_base: float  # local Z of absolute level 0
+    z_top: float
+    dz0: float  # finest Z step
+    levels: list[int]  # coarse to fine, e.g. [3, 2, 1, 0]
+
+    def dz(self, lv: int) -> float:
+        return self.dz0 * 2**lv
+
+    def count(self, lv: int) -> int:
+        """Absolute levels ``0 .. count - 1`` at pyramid level ``lv``."""
+        return int(math.floor((self.z_top - self.z_base) / self.dz(lv) + 1e-9)) + 1
+
+    def grid(self, grid: RasterGrid, lv: int) -> RasterGrid:
+        return grid if lv == 0 else grid.scaled(2**lv)
+
+    def level_params(self, params, lv: int):
+        """The tile parameters of level ``lv``: P2 divided by ``2^lv``.
+
+        A height jump costs P2 per cell step along a path, and an object ``w``
+        metres wide spans ``w / (2^lv res)`` cells whose matching evidence must
+        pay for two jumps: scaling P2 with the cell size keeps the price of a
+        jump per metre of object the same on every level, so small buildings
+        are not flattened away on the coarse levels.
+        """
+        if lv == 0:
+            return params
+        return dataclasses.replace(params, p2=max(params.p1 + 1, int(round(params.p2 / 2**lv))))
+
+
+def plan_levels(z_min: float, z_max: float, dz: float, grid: RasterGrid, max_levels: int = 5) -> LevelPlan:
+    n = (z_max - z_min) / dz
+    need = max(0, math.ceil(math.log2(max(n / COARSE_LEVELS, 1.0))))
+    top = max(need, 2)
+    while top > 0 and min(grid.scaled(2**top).shape) < MIN_COARSE_CELLS:
+        top -= 1
+    top = max(0, min(top, int(max_levels)))
+    # the range is extended so that every level's steps cover it
+    step = dz * 2**top
+    z_top = z_min + math.ceil((z_max - z_min) / step - 1e-9) * step
+    return LevelPlan(float(z_min), float(z_top), float(dz), list(range(top, -1, -1)))
+
+
+def neighbourhood_minmax(z: np.ndarray, radius: int) -> tuple[np.ndarray, np.ndarray]:
+    """NaN-aware minimum and maximum over ``(2 radius + 1)^2`` windows (NaN where all are NaN)."""
+    from scipy.ndimage import maximum_filter, minimum_filter
+
+    size = 2 * radius + 1
+    lo = minimum_filter(np.where(np.isfinite(z), z, np.inf), size=size, mode="nearest")
+    hi = maximum_filter(np.where(np.isfinite(z), z, -np.inf), size=size, mode="nearest")
+    lo[~np.isfinite(lo)] = np.nan
+    hi[~np.isfinite(hi)] = np.nan
+    return lo, hi
+
+
+def _to_levels(plan: LevelPlan, lv: int, zlo, zhi, centre=None) -> tuple[np.ndarray, np.ndarray]:
+    n = plan.count(lv)
+    d = plan.dz(lv)
+    lo = np.floor((zlo - plan.z_base) / d)
+    hi = np.ceil((zhi - plan.z_base) / d)
+    full = ~(np.isfinite(lo) & np.isfinite(hi))
+    lo = np.where(full, 0, np.clip(lo, 0, n - 1))
+    hi = np.where(full, n - 1, np.clip(hi, 0, n - 1))
+    wide = (hi - lo + 1) > MAX_BAND
+    if centre is not None and wide.any():
+        c = np.clip(np.rint((centre - plan.z_base) / d), 0, n - 1)
+        c = np.where(np.isfinite(c), c, 0.5 * (lo + hi))
+        nlo = np.clip(c - MAX_BAND // 2, lo, None)
+        nhi = np.minimum(nlo + MAX_BAND - 1, hi)
+        lo = np.where(wide, nlo, lo)
+        hi = np.where(wide, nhi, hi)
+    return lo.astype(np.int32), hi.astype(np.int32)
+
+
+def coarse_windows(plan: LevelPlan, lv: int, shape, surface=None) -> tuple[np.ndarray, np.ndarray]:
+    """Windows of the coarsest level: the whole range, or the bounds of a surface raster."""
+    if surface is None:
+        return (np.zeros(shape, np.int32), np.full(shape, plan.count(lv) - 1, np.int32))
+    zlo, zhi = surface
+    return _to_levels(plan, lv, zlo, zhi)
+
+
+def refine_windows(plan: LevelPlan, lv: int, coarse: np.ndarray, window) -> tuple[np.ndarray, np.ndarray]:
+    """Windows of the cells ``window = (r0, c0, rows, cols)`` of level ``lv`` from level ``lv + 1``."""
+    r0, c0, nr, nc = window
+    m = 4  # coarse cells of context around the window
+    cr0, cc0 = max(0, r0 // 2 - m), max(0, c0 // 2 - m)
+    cr1 = min(coarse.shape[0], (r0 + nr - 1) // 2 + m + 1)
+    cc1 = min(coarse.shape[1], (c0 + nc - 1) // 2 + m + 1)
+    patch = coarse[cr0:cr1, cc0:cc1]
+    lo3, hi3 = neighbourhood_minmax(patch, 2)
+    lo7, hi7 = neighbourhood_minmax(patch, 3)
+    lo = np.where(np.isfinite(lo3), lo3, lo7)
+    hi = np.where(np.isfinite(hi3), hi3, hi7)
+    if np.isfinite(patch).any():
+        lo = np.where(np.isfinite(lo), lo, np.nanmin(patch))
+        hi = np.where(np.isfinite(hi), hi, np.nanmax(patch))
+    margin = MARGIN_STEPS * plan.dz(lv + 1)
+    rr = np.clip(np.arange(r0, r0 + nr) // 2 - cr0, 0, patch.shape[0] - 1)
+    cc = np.clip(np.arange(c0, c0 + nc) // 2 - cc0, 0, patch.shape[1] - 1)
+    ix = np.ix_(rr, cc)
+    return _to_levels(plan, lv, lo[ix] - margin, hi[ix] + margin, patch[ix])

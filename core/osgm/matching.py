@@ -1,0 +1,268 @@
+"""OSGM on one tile of one pyramid level: voxel costs, aggregation, selection.
+
+The tile is a window of cells of a reference system's grid (cell centres
+``(X, Y)``, Z levels ``z = z_base + a dz`` with an absolute level index
+``a``). Every cell has its own search window of absolute levels ``[lo, hi]``
+(the whole range on the coarsest level, a band around the coarser result
+below). The cost volume holds ``nd`` levels per cell starting at ``z0``;
+levels outside the cell's own window keep ``COST_MAX`` (no evidence) and are
+never computed.
+
+1. **Images**: those that see the tile (projections of a lattice of the tile
+   at its lowest and highest Z inside the frame), at most ``max_images`` by
+   coverage, then by the angle between their viewing ray and the system's Z
+   axis; for each, the pyramid level whose pixel is closest to the cell size
+   and the pixel window the tile can project into.
+2. **Costs** per absolute level (a plane ``Z = const`` of the voxel grid):
+   every image is resampled onto the cells that search that level
+   (:func:`~.views.plane_map` + ``cv2.remap``), and
+   :func:`~truortho.core.sgm.multi_image_cost` compares all of them at once
+   (mean of the best pairs: robust to the views that are occluded there).
+3. :func:`~truortho.core.sgm.aggregate` along 8 or 16 paths in XY (P1, P2;
+   P2 lowered across edges of a guide image: the images sampled on the
+   coarser level's surface, median over the views), :func:`~truortho.core.sgm.select`
+   (winner-take-all, parabola, uniqueness, confidence), minima on the border
+   of a cell's own window rejected (the surface lies outside it), and a
+   NaN-aware median.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..geometry.camera import Camera
+from ..sgm import COST_MAX, aggregate, median_filter, multi_image_cost, select, valid_cells
+from .views import ImagePyramid, plane_map, project
+
+
+@dataclass
+class View:
+    """An image in the frame of a reference system."""
+
+    index: int  # position in the orientation (and the pyramid)
+    R: np.ndarray
+    C: np.ndarray
+    camera: Camera
+    r2max: float
+    axis_cos: float  # cosine between its optical axis and the system's -Z (viewing) direction
+
+
+@dataclass
+class TileImage:
+    view: View
+    level: int
+    origin: tuple[int, int]
+    window: np.ndarray  # float32 matching band, NaN outside the image
+    angle: float  # degrees between the viewing ray to the tile centre and the system's Z axis
+
+
+@dataclass
+class TileParams:
+    radius: int
+    measure: str
+    p1: int
+    p2: int
+    paths: int
+    uniqueness: float
+    max_images: int
+    max_view_angle: float
+    median: int
+
+
+def _lattice(x0, y0, res, rows, cols, n=9):
+    xs = x0 + np.linspace(0.0, cols, n) * res
+    ys = y0 - np.linspace(0.0, rows, n) * res
+    X, Y = np.meshgrid(xs, ys)
+    return X.ravel(), Y.ravel()
+
+
+def choose_images(
+    views, pyr: ImagePyramid, x0, y0, res, rows, cols, z_lo, z_hi, params: TileParams, colour: bool = False
+) -> list[TileImage]:
+    """The images that see the tile, with their pyramid level and pixel window."""
+    X, Y = _lattice(x0, y0, res, rows, cols)
+    zc = 0.5 * (z_lo + z_hi)
+    centre = np.array([x0 + 0.5 * cols * res, y0 - 0.5 * rows * res, zc])
+    cand = []
+    for v in views:
+        ray = centre - v.C
+        dist = float(np.linalg.norm(ray))
+        angle = math.degrees(math.acos(min(1.0, max(-1.0, -ray[2] / max(dist, 1e-12)))))
+        if angle > params.max_view_angle:
+            continue
+        uv_mid = project(np.column_stack([X, Y, np.full(X.size, zc)]), v.R, v.C, v.camera, v.r2max)
+        w, h = v.camera.width, v.camera.height
+        inside = (uv_mid[:, 0] >= -0.5) & (uv_mid[:, 0] <= w - 0.5) & (uv_mid[:, 1] >= -0.5)
+        inside &= uv_mid[:, 1] <= h - 0.5
+        cover = float(inside.mean())
+        if cover < 0.02:
+            continue
+        cand.append((cover, angle, dist, v))
+    # coverage first (in steps of a tenth, so near-equal coverage falls back to the angle)
+    cand.sort(key=lambda t: (-round(t[0] * 10), t[1]))
+    out = []
+    for _cover, angle, dist, v in cand[: params.max_images]:
+        depth = dist * max(v.axis_cos, 0.2)
+        gsd = depth / v.camera.fx
+        level = max(0, int(math.floor(math.log2(max(res / gsd, 1.0)) + 1e-6)))
+        pts = np.vstack([np.column_stack([X, Y, np.full(X.size, z)]) for z in (z_lo, z_hi)])
+        uv = project(pts, v.R, v.C, v.camera, v.r2max)
+        uv = uv[np.isfinite(uv[:, 0])]
+        if len(uv) == 0:
+            continue
+        s = 0.5**level
+        W, H = pyr.level_size(v.index, level)
+        u0 = int(math.floor((uv[:, 0].min() + 0.5) * s - 0.5)) - 3
+        u1 = int(math.ceil((uv[:, 0].max() + 0.5) * s - 0.5)) + 4
+        v0 = int(math.floor((uv[:, 1].min() + 0.5) * s - 0.5)) - 3
+        v1 = int(math.ceil((uv[:, 1].max() + 0.5) * s - 0.5)) + 4
+        u0, v0, u1, v1 = max(u0, -2), max(v0, -2), min(u1, W + 2), min(v1, H + 2)
+        if u1 <= u0 or v1 <= v0:
+            continue
+        win = pyr.window(v.index, level, u0, v0, u1 - u0, v1 - v0, colour=colour)
+        out.append(TileImage(v, level, (u0, v0), win, angle))
+    return out
+
+
+def _remap(img: TileImage, x0, y0, res, rows, cols, z) -> np.ndarray:
+    import cv2
+
+    mu, mv = plane_map(
+        x0,
+        y0,
+        res,
+        rows,
+        cols,
+        z,
+        img.view.R,
+        img.view.C,
+        img.view.camera,
+        img.view.r2max,
+        img.level,
+        img.origin,
+    )
+    return cv2.remap(  # type: ignore[call-overload]
+        img.window, mu, mv, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=np.nan
+    )
+
+
+def sample_surface(images: list[TileImage], x0, y0, res, z: np.ndarray) -> np.ndarray:
+    """Samples (n, rows, cols[, bands]) of every image at the cells' own heights ``z`` (NaN = none)."""
+    import cv2
+
+    rows, cols = z.shape
+    zz = np.where(np.isfinite(z), z, np.nanmedian(z) if np.isfinite(z).any() else 0.0)
+    out = []
+    X = x0 + (np.arange(cols) + 0.5) * res
+    Y = y0 - (np.arange(rows) + 0.5) * res
+    Xg, Yg = np.meshgrid(X, Y)
+    P = np.column_stack([Xg.ravel(), Yg.ravel(), zz.ravel()])
+    for img in images:
+        uv = project(P, img.view.R, img.view.C, img.view.camera, img.view.r2max)
+        s = 0.5**img.level
+        mu = ((uv[:, 0] + 0.5) * s - 0.5 - img.origin[0]).reshape(rows, cols).astype(np.float32)
+        mv = ((uv[:, 1] + 0.5) * s - 0.5 - img.origin[1]).reshape(rows, cols).astype(np.float32)
+        mu[~np.isfinite(mu)] = -1e6
+        mv[~np.isfinite(mv)] = -1e6
+        out.append(
+            cv2.remap(  # type: ignore[call-overload]
+                img.window, mu, mv, cv2.INTER_LINEAR, borderMode=cv2.BORDER_CONSTANT, borderValue=np.nan
+            )
+        )
+    return np.stack(out) if out else np.full((0, rows, cols), np.nan, np.float32)
+
+
+def _median_view(samples: np.ndarray) -> np.ndarray:
+    """Median over the views (NaN where none sees the cell)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return np.nanmedian(samples, axis=0).astype(np.float32)
+
+
+@dataclass
+class TileResult:
+    z: np.ndarray  # (rows, cols) float32, NaN where rejected
+    confidence: np.ndarray  # (rows, cols) float32
+    images: list[TileImage]
+    levels: int  # absolute levels evaluated
+    nd: int
+
+
+def match_tile(
+    views,
+    pyr: ImagePyramid,
+    x0,
+    y0,
+    res,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    z_base: float,
+    dz: float,
+    params: TileParams,
+    guide_z: np.ndarray | None = None,
+    cancelled=None,
+) -> TileResult:
+    """Match one tile: ``lo``/``hi`` (rows, cols) int32 absolute level windows (lo > hi: no search).
+
+    ``guide_z``: heights of the coarser level at these cells; the images sampled
+    there (median over the views) form the guide of the intensity-adaptive P2.
+    """
+    rows, cols = lo.shape
+    search = lo <= hi
+    nan = np.full((rows, cols), np.nan, np.float32)
+    if not search.any():
+        return TileResult(nan, nan.copy(), [], 0, 0)
+    a_min, a_max = int(lo[search].min()), int(hi[search].max())
+    images = choose_images(
+        views, pyr, x0, y0, res, rows, cols, z_base + a_min * dz, z_base + a_max * dz, params
+    )
+    if len(images) < 2:
+        return TileResult(nan, nan.copy(), images, 0, 0)
+    width = np.where(search, hi - lo + 1, 0)
+    nd = int(max(3, width.max()))
+    centre = (lo + hi) // 2
+    z0 = np.where(search, np.clip(centre - nd // 2, None, lo), 0)
+    z0 = np.where(search, np.maximum(z0, hi - nd + 1), 0).astype(np.int32)
+    cost = np.full((rows, cols, nd), COST_MAX, np.uint16)
+    pad = params.radius + 2
+    evaluated = 0
+    for a in range(a_min, a_max + 1):
+        if cancelled is not None and cancelled():
+            break
+        need = search & (lo <= a) & (a <= hi)
+        rr = np.nonzero(need.any(axis=1))[0]
+        if rr.size == 0:
+            continue
+        cc = np.nonzero(need.any(axis=0))[0]
+        r0, r1 = max(0, rr[0] - pad), min(rows, rr[-1] + pad + 1)
+        c0, c1 = max(0, cc[0] - pad), min(cols, cc[-1] + pad + 1)
+        # a minimum size keeps the per-slice gradient scale of the cost meaningful
+        if r1 - r0 < 24:
+            r0, r1 = max(0, min(r0, rows - 24)), min(rows, max(r1, r0 + 24))
+        if c1 - c0 < 24:
+            c0, c1 = max(0, min(c0, cols - 24)), min(cols, max(c1, c0 + 24))
+        za = z_base + a * dz
+        bx0, by0 = x0 + c0 * res, y0 - r0 * res
+        slices = np.stack([_remap(im, bx0, by0, res, r1 - r0, c1 - c0, za) for im in images])
+        c_b, _ = multi_image_cost(slices, params.radius, measure=params.measure)
+        ii, jj = np.nonzero(need[r0:r1, c0:c1])
+        gi, gj = ii + r0, jj + c0
+        cost[gi, gj, a - z0[gi, gj]] = c_b[ii, jj]
+        evaluated += 1
+    guide = None if guide_z is None else _median_view(sample_surface(images, x0, y0, res, guide_z))
+    S = aggregate(cost, params.p1, params.p2, params.paths, z0, guide=guide)
+    level, conf = select(S, z0, params.uniqueness, valid=valid_cells(cost) & search)
+    del S
+    li = np.rint(np.nan_to_num(level, nan=-1e9)).astype(np.int64)
+    edge = np.isfinite(level) & ((li <= lo) | (li >= hi))
+    level[edge] = np.nan
+    conf[edge] = np.nan
+    if params.median > 1:
+        level = median_filter(level, params.median, min_count=max(1, (params.median**2) // 2))
+        conf[~np.isfinite(level)] = np.nan
+    z = (z_base + level.astype(np.float64) * dz).astype(np.float32)
+    return TileResult(z, conf.astype(np.float32), images, evaluated, nd)

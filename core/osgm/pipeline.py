@@ -1,0 +1,764 @@
+"""OSGM from an orientation to a DSM, confidence, orthoimage and point cloud.
+
+:func:`run_osgm` discretises object space (cells ``dX = dY`` = the
+resolution, default the median GSD of the near-nadir images; ``dZ`` default
+= the resolution), finds the Z range (parameters, a coarse surface raster,
+the sparse tie points and GCPs, or from the block geometry), and matches
+coarse to fine (:mod:`.levels`): the coarsest level searches the whole
+range, every finer level a band around the result of the coarser one, so the
+work per cell stays small whatever the Z range. Every level runs by XY tiles
+with overlap (:func:`~.matching.match_tile`), so memory is bounded by the
+tile size and the band width, whatever the extent.
+
+Oblique blocks (``oblique="auto"``): besides the nadir system, the oblique
+images are grouped by viewing direction; each group defines a reference
+system whose Z axis points back along its mean viewing direction. All
+orientations are rotated into it, OSGM runs there unchanged (a 2.5D surface
+*as seen from that direction*: facades become its "roofs"), and its points
+are rotated back into the world frame and merged with the nadir ones into
+one point cloud (extra dimension ``system``).
+
+Outputs are written atomically (temporary file, renamed on success); a
+cancelled run writes nothing.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import CancelledError, InputError
+from ..geometry.frame import parse_crs, require_metric
+from ..grid import RasterGrid
+from ..orientation import Orientation
+from ..progress import Progress, as_progress
+from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
+from .levels import LevelPlan, coarse_windows, plan_levels, refine_windows
+from .matching import TileParams, View, choose_images, match_tile, sample_surface
+from .views import ImagePyramid, check_images, monotonic_radius2
+
+DSM_NODATA = -9999.0
+
+
+@dataclass
+class OsgmConfig:
+    """Parameters of :func:`run_osgm` (None = derived from the block, see the attributes).
+
+    Attributes
+    ----------
+    resolution : float, optional
+        Cell size ``dX = dY`` (CRS units); default the median GSD of the
+        near-nadir images at the median ground height.
+    z_step : float, optional
+        Voxel height ``dZ``; default the resolution.
+    z_min, z_max : float, optional
+        Search range (world heights); default from sparse points and GCPs
+        (0.5 / 99.5 percentiles, widened by a margin), else from the block.
+    z_margin : float, optional
+        Margin around a coarse surface raster or the sparse range; default
+        ``max(5 dZ, 10 % of the range, 2 m)``.
+    p1, p2 : int, optional
+        SGM penalties in cost units (``COST_MAX`` = 1023 = unrelated windows);
+        default :data:`~truortho.core.sgm.DEFAULT_P1`, ``DEFAULT_P2``.
+    paths : {8, 16}
+    adaptive_p2 : bool
+        Lower P2 across edges of the coarser level's orthoimage.
+    max_images : int
+        Images matched per tile (best coverage, then most nadir).
+    max_view_angle : float
+        Largest angle (degrees) between the ray to a tile and the system's Z axis.
+    oblique : {"none", "auto"}
+        ``"auto"``: additional reference systems for groups of oblique images.
+    oblique_group_angle : float
+        Largest angle between the viewing directions of the images of one
+        oblique system (degrees).
+    tile_size : int
+        Core tile side in cells (the overlap is added).
+    radius : int
+        Matching window radius in cells.
+    measure : {"gradient", "ncc", "census"}
+    uniqueness : float
+    median : int
+        Median filter size (odd; 1 = off).
+    band : int, optional
+        0-based band to match on; default the luminance.
+    max_levels : int
+        Upper bound of the pyramid depth.
+    cache_bytes : int
+        Budget of decoded images kept in memory.
+    """
+
+    resolution: float | None = None
+    z_step: float | None = None
+    z_min: float | None = None
+    z_max: float | None = None
+    z_margin: float | None = None
+    p1: int | None = None
+    p2: int | None = None
+    paths: int = 8
+    adaptive_p2: bool = True
+    max_images: int = 12
+    max_view_angle: float = 50.0
+    oblique: str = "none"
+    oblique_group_angle: float = 35.0
+    tile_size: int = 256
+    radius: int = 2
+    measure: str = "gradient"
+    uniqueness: float = 0.99
+    median: int = 3
+    band: int | None = None
+    max_levels: int = 5
+    cache_bytes: int = 1 << 30
+
+    def validate(self) -> None:
+        for name in ("resolution", "z_step", "z_margin"):
+            v = getattr(self, name)
+            if v is not None and not (math.isfinite(float(v)) and float(v) > 0):
+                raise InputError(f"{name.upper()}: expected a positive number, got {v!r}")
+        if self.z_min is not None and self.z_max is not None and not float(self.z_min) < float(self.z_max):
+            raise InputError(f"Z_MIN ({self.z_min}) must be below Z_MAX ({self.z_max})")
+        p1 = DEFAULT_P1 if self.p1 is None else int(self.p1)
+        p2 = DEFAULT_P2 if self.p2 is None else int(self.p2)
+        if not (0 <= p1 < p2 <= P2_MAX):
+            raise InputError(f"P1, P2: expected 0 <= P1 < P2 <= {P2_MAX}, got P1={p1}, P2={p2}")
+        if self.paths not in (8, 16):
+            raise InputError(f"PATHS: expected 8 or 16, got {self.paths!r}")
+        if int(self.max_images) < 2:
+            raise InputError(f"MAX_IMAGES: at least 2 images are needed per tile, got {self.max_images!r}")
+        if self.oblique not in ("none", "auto"):
+            raise InputError(f"OBLIQUE: expected 'none' or 'auto', got {self.oblique!r}")
+        if int(self.tile_size) < 32:
+            raise InputError(f"TILE_SIZE: expected at least 32 cells, got {self.tile_size!r}")
+        if self.median < 1 or self.median % 2 == 0:
+            raise InputError(f"median: expected an odd size >= 1, got {self.median!r}")
+        if not 0 < float(self.max_view_angle) < 90:
+            raise InputError(f"max_view_angle: expected degrees in (0, 90), got {self.max_view_angle!r}")
+
+    def tile_params(self) -> TileParams:
+        return TileParams(
+            radius=int(self.radius),
+            measure=self.measure,
+            p1=DEFAULT_P1 if self.p1 is None else int(self.p1),
+            p2=DEFAULT_P2 if self.p2 is None else int(self.p2),
+            paths=int(self.paths),
+            uniqueness=float(self.uniqueness),
+            max_images=int(self.max_images),
+            max_view_angle=float(self.max_view_angle),
+            median=int(self.median),
+        )
+
+
+@dataclass
+class OsgmOutputs:
+    """Destinations; ``dsm`` is required, the others optional."""
+
+    dsm: str | os.PathLike
+    confidence: str | os.PathLike | None = None
+    orthoimage: str | os.PathLike | None = None
+    point_cloud: str | os.PathLike | None = None
+
+    def validate(self) -> None:
+        if self.dsm is None:
+            raise InputError("DSM: an output path is required")
+        paths = [("DSM", self.dsm), ("CONFIDENCE", self.confidence), ("ORTHOIMAGE", self.orthoimage)]
+        for name, p in paths:
+            if p is not None and Path(p).suffix.lower() not in (".tif", ".tiff"):
+                raise InputError(f"{name}: expected a GeoTIFF path (.tif), got {p}")
+        if self.point_cloud is not None and Path(self.point_cloud).suffix.lower() not in (".las", ".laz"):
+            raise InputError(f"POINT_CLOUD: expected a .las or .laz path, got {self.point_cloud}")
+        given = [str(Path(p).resolve()) for _, p in paths if p is not None]
+        if self.point_cloud is not None:
+            given.append(str(Path(self.point_cloud).resolve()))
+        if len(set(given)) != len(given):
+            raise InputError("outputs: two outputs have the same path")
+
+
+@dataclass
+class OsgmResult:
+    grid: RasterGrid
+    stats: dict = field(default_factory=dict)
+    paths: dict = field(default_factory=dict)
+
+    def summary(self) -> str:
+        s = self.stats
+        text = (
+            f"OSGM DSM {s['cols']} x {s['rows']} cells at {s['resolution']:.3f} m, dZ {s['z_step']:.3f} m, "
+            f"Z {s['z_min']:.2f} .. {s['z_max']:.2f} ({s['z_source']}), {s['levels']} pyramid level(s), "
+            f"{s['tiles']} tiles; completeness {100 * s['completeness']:.2f} %, "
+            f"mean confidence {s['mean_confidence']:.3f}; {s['seconds']:.1f} s"
+        )
+        for sysd in s.get("systems", [])[1:]:
+            text += f"; system {sysd['id']} ({sysd['name']}): {sysd['points']} points"
+        return text
+
+
+# ------------------------------------------------------------------ reference systems
+
+
+@dataclass
+class RefSystem:
+    id: int
+    name: str
+    Q: np.ndarray  # rotation local -> system
+    direction: np.ndarray  # world viewing direction (unit, towards the scene)
+    images: list[int]
+
+
+def _axis_rotation(direction) -> np.ndarray:
+    """Rotation whose third row is ``-direction`` (system Z points back towards the cameras)."""
+    z = -np.asarray(direction, np.float64)
+    z /= np.linalg.norm(z)
+    ref = np.array([0.0, 0.0, 1.0]) if abs(z[2]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    x = np.cross(ref, z)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    return np.vstack([x, y, z])
+
+
+def reference_systems(orientation: Orientation, mode: str, group_angle: float) -> list[RefSystem]:
+    """The nadir system, plus one per group of oblique images when ``mode == "auto"``."""
+    dirs = np.array([im.R[2] for im in orientation.images])  # optical axes in the world
+    tilt = np.degrees(np.arccos(np.clip(-dirs[:, 2], -1, 1)))
+    systems = [RefSystem(0, "nadir", np.eye(3), np.array([0.0, 0.0, -1.0]), list(range(len(dirs))))]
+    if mode != "auto":
+        return systems
+    obl = [i for i in range(len(dirs)) if tilt[i] > 20.0]
+    cosg = math.cos(math.radians(group_angle))
+    left = set(obl)
+    while left:
+        groups = {i: [j for j in left if dirs[i] @ dirs[j] >= cosg] for i in left}
+        i = max(groups, key=lambda k: (len(groups[k]), -k))
+        members = groups[i]
+        d = dirs[members].mean(axis=0)
+        d /= np.linalg.norm(d)
+        left -= set(members)
+        users = [j for j in range(len(dirs)) if dirs[j] @ d >= math.cos(math.radians(group_angle + 15))]
+        if len(users) < 2:
+            continue
+        az = math.degrees(math.atan2(d[0], d[1])) % 360
+        systems.append(
+            RefSystem(len(systems), f"oblique towards azimuth {az:.0f} deg", _axis_rotation(d), d, users)
+        )
+    return systems
+
+
+def _system_views(orientation: Orientation, system: RefSystem) -> list[View]:
+    views = []
+    axis = -system.Q[2]
+    for i in system.images:
+        im = orientation.images[i]
+        cam = orientation.camera_of(im)
+        views.append(
+            View(i, im.R @ system.Q.T, system.Q @ im.C, cam, monotonic_radius2(cam), float(im.R[2] @ axis))
+        )
+    return views
+
+
+# ------------------------------------------------------------------ defaults from the block
+
+
+def _load(orientation) -> Orientation:
+    if isinstance(orientation, Orientation):
+        return orientation
+    if isinstance(orientation, str | os.PathLike):
+        return Orientation.load(orientation)
+    raise InputError(f"ORIENTATION: expected an orientation file or object, got {type(orientation).__name__}")
+
+
+def _known_heights(o: Orientation) -> np.ndarray:
+    """Local Z of sparse points and GCPs."""
+    zs = []
+    if o.points is not None and len(o.points):
+        zs.append(o.points.xyz[:, 2])
+    if o.gcps:
+        zs.append(np.array([g.xyz[2] for g in o.gcps], np.float64) - o.offset[2])
+    return np.concatenate(zs) if zs else np.zeros(0)
+
+
+def _nadir(o: Orientation) -> list[int]:
+    idx = [i for i, im in enumerate(o.images) if im.R[2, 2] < -math.cos(math.radians(25))]
+    return idx or list(range(len(o.images)))
+
+
+def z_range(o: Orientation, cfg: OsgmConfig) -> tuple[float, float, str]:
+    """Local (zmin, zmax) and where it comes from."""
+    off = o.offset[2]
+    if cfg.z_min is not None and cfg.z_max is not None:
+        return float(cfg.z_min) - off, float(cfg.z_max) - off, "Z_MIN/Z_MAX"
+    zs = _known_heights(o)
+    cams = np.array([o.images[i].C[2] for i in _nadir(o)])
+    if len(zs) >= 2 and o.points is not None and len(o.points) >= 20:
+        lo, hi = np.percentile(zs, [0.5, 99.5])
+        margin = cfg.z_margin or max(10 * (cfg.z_step or 0.0), 0.1 * (hi - lo), 2.0)
+        lo, hi, src = lo - margin, hi + margin, "sparse points"
+    elif len(zs):
+        # ground known (GCPs) but not the objects on it: up to half the flying height above the highest
+        ground_lo, ground_hi = float(zs.min()), float(zs.max())
+        height = float(np.median(cams)) - ground_hi
+        if not height > 0:
+            raise InputError("Z_MIN/Z_MAX: the cameras are not above the control points; give the Z range")
+        lo, hi, src = (
+            ground_lo - max(2.0, 0.05 * height),
+            ground_hi + 0.5 * height,
+            "GCP heights and flying height",
+        )
+    else:
+        raise InputError(
+            "Z_MIN/Z_MAX: the orientation has no sparse points or GCPs to derive the height range from; "
+            "give Z_MIN and Z_MAX or a Z_SURFACE raster"
+        )
+    if cfg.z_min is not None:
+        lo = float(cfg.z_min) - off
+    if cfg.z_max is not None:
+        hi = float(cfg.z_max) - off
+    if not hi > lo:
+        raise InputError(f"Z_MIN/Z_MAX: empty height range {lo + off:.3f} .. {hi + off:.3f}")
+    # never at or above the cameras
+    top = float(np.min(cams)) - 1.0
+    if hi > top:
+        hi = max(top, lo + 1.0)
+    return float(lo), float(hi), src
+
+
+def default_resolution(o: Orientation, z_local: float) -> float:
+    g = [abs(o.images[i].C[2] - z_local) / o.camera_of(o.images[i]).fx for i in _nadir(o)]
+    return float(np.median(g))
+
+
+def default_extent(o: Orientation, z_local: float) -> tuple[float, float, float, float]:
+    """World extent: the sparse points (1-99 %), else the union of the near-nadir footprints."""
+    from ..geometry.footprint import footprint_on_plane
+
+    off = o.offset
+    if o.points is not None and len(o.points) >= 20:
+        lo = np.percentile(o.points.xyz[:, :2], 1, axis=0)
+        hi = np.percentile(o.points.xyz[:, :2], 99, axis=0)
+    else:
+        pts = []
+        for i in _nadir(o):
+            im = o.images[i]
+            fp = footprint_on_plane(im.R, im.C, o.camera_of(im), z_local)
+            if fp is not None:
+                pts.append(fp)
+        if not pts:
+            raise InputError("EXTENT: no image sees the ground; give an extent")
+        allp = np.vstack(pts)
+        lo, hi = allp.min(axis=0), allp.max(axis=0)
+    return (float(lo[0] + off[0]), float(lo[1] + off[1]), float(hi[0] + off[0]), float(hi[1] + off[1]))
+
+
+# ------------------------------------------------------------------ one system
+
+
+@dataclass
+class SystemResult:
+    grid: RasterGrid  # in the system frame (local, rotated); crs of the orientation for nadir
+    z: np.ndarray
+    confidence: np.ndarray
+    rgb: np.ndarray | None
+    plan: LevelPlan
+    tiles: int
+
+
+def _match_system(
+    o,
+    system,
+    pyr,
+    grid,
+    plan: LevelPlan,
+    cfg: OsgmConfig,
+    progress,
+    z_surface_windows=None,
+    want_colour=False,
+) -> SystemResult:
+    """Coarse-to-fine OSGM of one reference system over ``grid`` (system frame, local)."""
+    params = cfg.tile_params()
+    views = _system_views(o, system)
+    prev_z: np.ndarray | None = None
+    prev_filled: np.ndarray | None = None
+    n_tiles = 0
+    total = sum(plan.grid(grid, lv).rows * plan.grid(grid, lv).cols for lv in plan.levels)
+    done_cells = 0
+    for lv in plan.levels:  # coarse to fine
+        g = plan.grid(grid, lv)
+        dz = plan.dz(lv)
+        z = np.full(g.shape, np.nan, np.float32)
+        conf = np.full(g.shape, np.nan, np.float32)
+        ts = int(cfg.tile_size)
+        ov = max(16, ts // 8)
+        for tile in g.tiles(ts, ov):
+            if progress.cancelled():
+                raise CancelledError("OSGM cancelled")
+            r0, c0, nr, nc = tile.outer
+            if prev_z is None:
+                lo, hi = coarse_windows(
+                    plan,
+                    lv,
+                    (nr, nc),
+                    None
+                    if z_surface_windows is None
+                    else tuple(w[r0 : r0 + nr, c0 : c0 + nc] for w in z_surface_windows),
+                )
+                guide = None
+            else:
+                lo, hi = refine_windows(plan, lv, prev_z, (r0, c0, nr, nc))
+                assert prev_filled is not None
+                guide = _interpolate(prev_filled, (r0, c0, nr, nc)) if cfg.adaptive_p2 else None
+            tx0, ty0 = g.x_min + c0 * g.res, g.y_max - r0 * g.res
+            res = match_tile(
+                views,
+                pyr,
+                tx0,
+                ty0,
+                g.res,
+                lo,
+                hi,
+                plan.z_base,
+                dz,
+                plan.level_params(params, lv),
+                guide,
+                progress.cancelled,
+            )
+            if progress.cancelled():
+                raise CancelledError("OSGM cancelled")
+            ins, core = tile.inner_slices, tile.core_slices
+            z[core] = res.z[ins]
+            conf[core] = res.confidence[ins]
+            n_tiles += 1
+            done_cells += tile.core[2] * tile.core[3]
+            progress.update(done_cells / total, f"{system.name}: level {lv} tile {tile.index}")
+        prev_z = z
+        prev_filled = _fill_nearest(z)
+    assert prev_z is not None
+    rgb = _colours(views, pyr, grid, prev_z, cfg) if want_colour else None
+    return SystemResult(grid, prev_z, conf, rgb, plan, n_tiles)
+
+
+def _fill_nearest(z: np.ndarray) -> np.ndarray:
+    """NaN cells take the value of the nearest valid cell (all NaN stays NaN)."""
+    from scipy.ndimage import distance_transform_edt
+
+    bad = ~np.isfinite(z)
+    if not bad.any() or bad.all():
+        return z
+    idx = distance_transform_edt(bad, return_distances=False, return_indices=True)
+    return z[tuple(idx)]
+
+
+def _interpolate(coarse: np.ndarray, window) -> np.ndarray:
+    """Bilinear values of the coarser level at the cell centres ``window`` of the finer one."""
+    from scipy.ndimage import map_coordinates
+
+    r0, c0, nr, nc = window
+    rr = (np.arange(r0, r0 + nr) + 0.5) / 2 - 0.5
+    cc = (np.arange(c0, c0 + nc) + 0.5) / 2 - 0.5
+    R, C = np.meshgrid(rr, cc, indexing="ij")
+    return map_coordinates(coarse, [R, C], order=1, mode="nearest").astype(np.float32)
+
+
+def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig) -> np.ndarray:
+    """Colour of the best visible image per cell (uint8 RGB, 0 where none).
+
+    Per tile, all candidate images are sampled at the matched surface; an image
+    counts as seeing the cell when its luminance is within 0.1 of the median of
+    all views there (an occluded view sees something else), and among those the
+    one whose ray is closest to the system's Z axis gives the colour.
+    """
+    params = cfg.tile_params()
+    params.max_images = max(params.max_images, 16)
+    out = np.zeros(grid.shape + (3,), np.uint8)
+    for tile in grid.tiles(int(cfg.tile_size), 0):
+        r0, c0, nr, nc = tile.outer
+        zt = z[r0 : r0 + nr, c0 : c0 + nc]
+        ok = np.isfinite(zt)
+        if not ok.any():
+            continue
+        tx0, ty0 = grid.x_min + c0 * grid.res, grid.y_max - r0 * grid.res
+        lo, hi = float(np.nanmin(zt)), float(np.nanmax(zt))
+        imgs = choose_images(views, pyr, tx0, ty0, grid.res, nr, nc, lo, hi, params, colour=True)
+        if not imgs:
+            continue
+        col = sample_surface(imgs, tx0, ty0, grid.res, zt)  # (n, rows, cols, 3)
+        scale = np.array([np.nanmax(im.window) if np.isfinite(im.window).any() else 1.0 for im in imgs])
+        scale = np.where(scale > 255.0, 65535.0, 255.0)
+        lum = (col[..., 0] * 0.299 + col[..., 1] * 0.587 + col[..., 2] * 0.114) / scale[:, None, None]
+        import warnings
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            med = np.nanmedian(lum, axis=0)
+        agree = np.abs(lum - med[None]) <= 0.1
+        angle = np.array([im.angle for im in imgs])[:, None, None]
+        score = np.where(agree, angle, np.inf)
+        best = np.argmin(score, axis=0)
+        has = np.isfinite(np.take_along_axis(score, best[None], 0)[0]) & ok
+        c = np.take_along_axis(col, best[None, :, :, None], 0)[0] / scale[best][..., None] * 255.0
+        tile_rgb = np.where(has[..., None], np.clip(np.nan_to_num(c) + 0.5, 1, 255), 0).astype(np.uint8)
+        out[r0 : r0 + nr, c0 : c0 + nc] = tile_rgb
+    return out
+
+
+# ------------------------------------------------------------------ the entry point
+
+
+def run_osgm(
+    orientation,
+    config: OsgmConfig | None = None,
+    extent=None,
+    outputs: OsgmOutputs | None = None,
+    image_root=None,
+    z_surface=None,
+    progress: Progress | None = None,
+) -> OsgmResult:
+    """Object-space semi-global multi-image matching of an oriented block.
+
+    Parameters
+    ----------
+    orientation : Orientation or path of an orientation JSON
+    config : OsgmConfig
+    extent : (xmin, ymin, xmax, ymax), optional
+        World coordinates in the orientation's CRS; default the sparse points'
+        extent or the union of the near-nadir footprints.
+    outputs : OsgmOutputs
+        DSM (float32 GeoTIFF, nodata -9999), CONFIDENCE (float32 in [0, 1]),
+        ORTHOIMAGE (uint8 RGB, 0 = no data), POINT_CLOUD (LAS/LAZ with RGB,
+        confidence and reference system).
+    image_root : path, optional
+        Folder the image paths are relative to (default the orientation's).
+    z_surface : path, optional
+        A coarse DSM/DTM raster: per-cell search bounds ``[min - margin, max + margin]``
+        of its 3 x 3 neighbourhood on the coarsest level.
+    progress : Progress, optional
+
+    Returns
+    -------
+    OsgmResult
+    """
+    t0 = time.perf_counter()
+    progress = as_progress(progress)
+    cfg = config or OsgmConfig()
+    cfg.validate()
+    if outputs is None:
+        raise InputError("DSM: an output path is required")
+    outputs.validate()
+    o = _load(orientation)
+    o.validate()
+    if o.crs is None:
+        raise InputError("ORIENTATION: the orientation has no CRS; georeference it first")
+    require_metric(parse_crs(o.crs), "orientation CRS")
+    if len(o.images) < 2:
+        raise InputError("ORIENTATION: at least two oriented images are needed")
+    paths = [str(o.resolve_image_path(im, image_root)) for im in o.images]
+    sizes = [(o.camera_of(im).width, o.camera_of(im).height) for im in o.images]
+    o.check_images_exist(image_root)
+    check_images(paths, sizes)
+
+    zmin, zmax, zsrc = z_range(o, cfg)
+    zs_mid = 0.5 * (zmin + zmax)
+    ground = float(np.median(_known_heights(o))) if len(_known_heights(o)) else zmin
+    res = float(cfg.resolution) if cfg.resolution else default_resolution(o, ground)
+    dz = float(cfg.z_step) if cfg.z_step else res
+    if extent is None:
+        extent = default_extent(o, ground)
+    grid = RasterGrid.from_extent(extent, res, o.crs)
+    _check_overlap(o, grid, ground)
+    off = o.offset
+    local = RasterGrid(grid.x_min - off[0], grid.y_max - off[1], res, grid.rows, grid.cols, o.crs)
+    pyr = ImagePyramid(paths, sizes, cfg.band, cfg.cache_bytes)
+    systems = reference_systems(o, cfg.oblique, cfg.oblique_group_angle)
+    weights = [1.0] + [0.5] * (len(systems) - 1)
+    wsum = sum(weights)
+    from ..progress import SubProgress
+
+    # --- nadir system
+    plan = plan_levels(zmin, zmax, dz, local, cfg.max_levels)
+    zsw = None
+    if z_surface is not None:
+        zsw = _surface_windows(z_surface, grid, plan, cfg, off[2])
+        zsrc = "Z_SURFACE"
+    nadir = _match_system(
+        o,
+        systems[0],
+        pyr,
+        local,
+        plan,
+        cfg,
+        SubProgress(progress, 0, 0.8 * weights[0] / wsum),
+        zsw,
+        want_colour=True,
+    )
+    dsm = np.where(np.isfinite(nadir.z), nadir.z + off[2], np.nan).astype(np.float32)
+    conf = np.where(np.isfinite(nadir.z), np.clip(np.nan_to_num(nadir.confidence), 0, 1), np.nan).astype(
+        np.float32
+    )
+
+    # --- oblique systems
+    clouds = []
+    sys_stats = [
+        {
+            "id": 0,
+            "name": "nadir",
+            "view_direction": [0.0, 0.0, -1.0],
+            "images": len(o.images),
+            "points": int(np.isfinite(dsm).sum()),
+        }
+    ]
+    pos = 0.8 * weights[0] / wsum
+    for s, w in zip(systems[1:], weights[1:], strict=True):
+        sub = SubProgress(progress, pos, pos + 0.8 * w / wsum)
+        pos += 0.8 * w / wsum
+        cloud = _oblique_points(
+            o, s, pyr, local, zmin, zmax, dz, cfg, sub, want_rgb=outputs.point_cloud is not None
+        )
+        clouds.append(cloud)
+        sys_stats.append(
+            {
+                "id": s.id,
+                "name": s.name,
+                "view_direction": [float(v) for v in s.direction],
+                "images": len(s.images),
+                "points": int(len(cloud[0])),
+            }
+        )
+
+    if progress.cancelled():
+        raise CancelledError("OSGM cancelled")
+    progress.update(0.85, "writing outputs")
+    written = _write_outputs(o, grid, dsm, conf, nadir.rgb, clouds, systems, outputs, res)
+    ok = np.isfinite(dsm)
+    stats = {
+        "rows": grid.rows,
+        "cols": grid.cols,
+        "resolution": res,
+        "z_step": dz,
+        "z_min": zmin + off[2],
+        "z_max": zmax + off[2],
+        "z_source": zsrc,
+        "z_mid": zs_mid + off[2],
+        "levels": len(plan.levels),
+        "tiles": nadir.tiles,
+        "extent": list(grid.extent),
+        "completeness": float(ok.mean()),
+        "mean_confidence": float(np.nanmean(conf)) if ok.any() else 0.0,
+        "systems": sys_stats,
+        "images": len(o.images),
+        "image_reads": pyr.reads,
+        "seconds": time.perf_counter() - t0,
+    }
+    progress.update(1.0, "OSGM done")
+    return OsgmResult(grid, stats, written)
+
+
+def _check_overlap(o: Orientation, grid: RasterGrid, ground: float) -> None:
+    """The extent must meet the area the images see (clear error instead of an empty DSM)."""
+    off = o.offset
+    x0, y0, x1, y1 = grid.extent
+    try:
+        bx0, by0, bx1, by1 = default_extent(o, ground)
+    except InputError:
+        return
+    if x1 < bx0 or x0 > bx1 or y1 < by0 or y0 > by1:
+        raise InputError(
+            f"EXTENT: ({x0:.2f}, {y0:.2f}, {x1:.2f}, {y1:.2f}) does not intersect the area the images see "
+            f"({bx0:.2f}, {by0:.2f}, {bx1:.2f}, {by1:.2f}) in {o.crs}"
+        )
+    del off
+
+
+def _surface_windows(path, grid: RasterGrid, plan: LevelPlan, cfg: OsgmConfig, off_z: float):
+    from ..rasterio_io import read_onto_grid
+    from .levels import neighbourhood_minmax
+
+    lv = plan.levels[0]
+    g = plan.grid(grid, lv)
+    surf = read_onto_grid(path, g, resampling="bilinear") - off_z
+    if not np.isfinite(surf).any():
+        raise InputError(f"Z_SURFACE: {path} has no data over the extent")
+    lo, hi = neighbourhood_minmax(surf, 1)
+    margin = cfg.z_margin or max(5 * plan.dz(lv), 2.0)
+    return lo - margin, hi + margin
+
+
+def _oblique_points(o, system, pyr, local: RasterGrid, zmin, zmax, dz, cfg, progress, want_rgb):
+    """Points (world xyz, rgb, confidence) of one oblique reference system."""
+    Q = system.Q
+    x0, y0, x1, y1 = local.extent
+    corners = np.array([[x, y, z] for x in (x0, x1) for y in (y0, y1) for z in (zmin, zmax)])
+    sc = corners @ Q.T
+    s_lo, s_hi = sc.min(axis=0), sc.max(axis=0)
+    res = local.res
+    sgrid = RasterGrid.from_extent((s_lo[0], s_lo[1], s_hi[0], s_hi[1]), res, None)
+    plan = plan_levels(float(s_lo[2]), float(s_hi[2]), dz, sgrid, cfg.max_levels)
+    r = _match_system(o, system, pyr, sgrid, plan, cfg, progress, None, want_colour=want_rgb)
+    ok = np.isfinite(r.z)
+    X, Y = sgrid.centres()
+    S = np.column_stack([X[ok], Y[ok], r.z[ok].astype(np.float64)])
+    L = S @ Q  # system -> local
+    inside = (L[:, 0] >= x0) & (L[:, 0] <= x1) & (L[:, 1] >= y0) & (L[:, 1] <= y1)
+    inside &= (L[:, 2] >= zmin) & (L[:, 2] <= zmax)
+    world = L[inside] + o.offset
+    rgb = r.rgb[ok][inside] if r.rgb is not None else None
+    conf = np.clip(np.nan_to_num(r.confidence[ok][inside]), 0, 1).astype(np.float32)
+    return world, rgb, conf
+
+
+def _write_outputs(o, grid, dsm, conf, rgb, clouds, systems, outputs: OsgmOutputs, res) -> dict:
+    from ..rasterio_io import write_raster
+
+    written = {}
+    nod = np.where(np.isfinite(dsm), dsm, DSM_NODATA).astype(np.float32)
+    tmp_ortho = None
+    write_raster(outputs.dsm, nod, grid, nodata=DSM_NODATA, overviews=True, descriptions=["height"])
+    written["dsm"] = str(outputs.dsm)
+    if outputs.confidence is not None:
+        write_raster(
+            outputs.confidence,
+            np.where(np.isfinite(conf), conf, -1.0).astype(np.float32),
+            grid,
+            nodata=-1.0,
+            descriptions=["confidence"],
+        )
+        written["confidence"] = str(outputs.confidence)
+    if outputs.orthoimage is not None:
+        write_raster(outputs.orthoimage, np.moveaxis(rgb, -1, 0), grid, nodata=0, overviews=True)
+        written["orthoimage"] = str(outputs.orthoimage)
+    if outputs.point_cloud is not None:
+        from ..surface.pointcloud import (
+            PointCloud,
+            ReferenceSystem,
+            merge_point_clouds,
+            write_point_cloud_file,
+        )
+
+        ok = np.isfinite(dsm)
+        X, Y = grid.centres()
+        refs = [
+            ReferenceSystem(
+                s.id, s.name, (float(s.direction[0]), float(s.direction[1]), float(s.direction[2]))
+            )
+            for s in systems
+        ]
+        parts = [
+            PointCloud(
+                np.column_stack([X[ok], Y[ok], dsm[ok].astype(np.float64)]),
+                rgb[ok],
+                conf[ok],
+                np.zeros(int(ok.sum()), np.uint16),
+                o.crs,
+                [refs[0]],
+            )
+        ]
+        for (xyz, prgb, pconf), ref in zip(clouds, refs[1:], strict=True):
+            if len(xyz):
+                parts.append(PointCloud(xyz, prgb, pconf, np.full(len(xyz), ref.id, np.uint16), o.crs, [ref]))
+        cloud = merge_point_clouds(parts, voxel=None) if len(parts) > 1 else parts[0]
+        cloud.systems = refs
+        write_point_cloud_file(outputs.point_cloud, cloud)
+        written["point_cloud"] = str(outputs.point_cloud)
+    del tmp_ortho, res
+    return written
