@@ -558,9 +558,13 @@ def run_osgm(
     o.check_images_exist(image_root)
     check_images(paths, sizes)
 
-    zmin, zmax, zsrc = z_range(o, cfg)
+    if z_surface is not None and (cfg.z_min is None or cfg.z_max is None):
+        zmin, zmax, zsrc = _surface_range(z_surface, o, cfg, extent)
+    else:
+        zmin, zmax, zsrc = z_range(o, cfg)
     zs_mid = 0.5 * (zmin + zmax)
-    ground = float(np.median(_known_heights(o))) if len(_known_heights(o)) else zmin
+    known = _known_heights(o)
+    ground = float(np.median(known)) if len(known) else zmin
     res = float(cfg.resolution) if cfg.resolution else default_resolution(o, ground)
     dz = float(cfg.z_step) if cfg.z_step else res
     if extent is None:
@@ -668,6 +672,27 @@ def _check_overlap(o: Orientation, grid: RasterGrid, ground: float) -> None:
             f"({bx0:.2f}, {by0:.2f}, {bx1:.2f}, {by1:.2f}) in {o.crs}"
         )
     del off
+
+
+def _surface_range(path, o: Orientation, cfg: OsgmConfig, extent) -> tuple[float, float, str]:
+    """Local Z range of a surface raster over the extent (or all of it), widened by the margin."""
+    from ..rasterio_io import raster_grid, read_onto_grid
+
+    sg = raster_grid(path, require_crs=True)
+    ext = extent if extent is not None else sg.extent
+    step = max(sg.res, (ext[2] - ext[0]) / 512, (ext[3] - ext[1]) / 512)
+    g = RasterGrid.from_extent(ext, step, o.crs)
+    vals = read_onto_grid(path, g, resampling="nearest")
+    if not np.isfinite(vals).any():
+        raise InputError(f"Z_SURFACE: {path} has no data over the extent")
+    lo, hi = float(np.nanmin(vals)), float(np.nanmax(vals))
+    margin = cfg.z_margin or max(5 * (cfg.z_step or 0.0), 2.0)
+    off = o.offset[2]
+    zlo = (float(cfg.z_min) if cfg.z_min is not None else lo - margin) - off
+    zhi = (float(cfg.z_max) if cfg.z_max is not None else hi + margin) - off
+    if not zhi > zlo:
+        raise InputError(f"Z_MIN/Z_MAX: empty height range {zlo + off:.3f} .. {zhi + off:.3f}")
+    return zlo, zhi, "Z_SURFACE"
 
 
 def _surface_windows(path, grid: RasterGrid, plan: LevelPlan, cfg: OsgmConfig, off_z: float):

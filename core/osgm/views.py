@@ -228,6 +228,8 @@ class ImagePyramid:
             part = self._read_window(i, level, ix0, iy0, ix1 - ix0, iy1 - iy0, colour)
         else:
             part = self._full(i, level, colour)[iy0:iy1, ix0:ix1]
+        if colour and part.ndim == 2:
+            part = part[:, :, None]
         if colour and part.shape[2] == 1:
             part = np.repeat(part, 3, axis=2)
         out[iy0 - y0 : iy1 - y0, ix0 - x0 : ix1 - x0] = part

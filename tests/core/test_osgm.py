@@ -1,0 +1,344 @@
+"""OSGM (object-space semi-global multi-image matching) against synthetic truth.
+
+Acceptance (nadir block, 80/60 overlap, textured, buildings and a 32 m tower): against the truth DSM
+on the same grid, over the cells whose surface point is seen by at least two images (nothing can be
+matched elsewhere): NMAD <= 1 GSD, >= 95 % of the cells away from building edges within 3 GSD,
+completeness >= 98 %, >= 80 % of the cells within 2 GSD of building edges within 3 GSD.
+Obliques: facade points appear only with the oblique reference systems.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+cv2 = pytest.importorskip("cv2")
+
+from truortho.core.errors import CancelledError, InputError, MissingFileError  # noqa: E402
+from truortho.core.geometry import project_points  # noqa: E402
+from truortho.core.grid import RasterGrid  # noqa: E402
+from truortho.core.osgm import OsgmConfig, OsgmOutputs, plan_levels, reference_systems, run_osgm  # noqa: E402
+from truortho.core.osgm.levels import MAX_BAND, refine_windows  # noqa: E402
+from truortho.core.osgm.views import monotonic_radius2, plane_map  # noqa: E402
+from truortho.core.progress import CallbackProgress  # noqa: E402
+from truortho.core.rasterio_io import read_raster  # noqa: E402
+from truortho.core.synthetic import SceneConfig, make_scene  # noqa: E402
+
+
+def _small_config(**kw):
+    base = dict(
+        extent=(-20.0, -15.0, 20.0, 15.0), n_buildings=2, building_size=(7.0, 11.0), building_gap=3.0,
+        tower=False, image_size=(240, 180), focal_px=300.0, n_oblique=0, seed=5,
+    )  # fmt: skip
+    base.update(kw)
+    return SceneConfig(**base)
+
+
+@pytest.fixture(scope="module")
+def small_scene(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("osgm_small")
+    scene = make_scene(_small_config())
+    scene.write(folder)
+    return scene, folder
+
+
+def _truth_and_seen(scene, grid):
+    X, Y = grid.centres()
+    truth = scene.height(np.column_stack([X.ravel(), Y.ravel()])).reshape(grid.shape)
+    P = np.column_stack([X.ravel(), Y.ravel(), truth.ravel()])
+    n = sum(scene.visibility(P, i, tol=0.05)[0].astype(int) for i in range(len(scene.orientation.images)))
+    return truth, n.reshape(grid.shape)
+
+
+# ------------------------------------------------------------------ kernels and plans
+
+
+def test_plane_map_is_the_collinearity_projection(small_scene):
+    scene, _ = small_scene
+    cam = scene.camera
+    im = scene.orientation.images[0]
+    r2 = monotonic_radius2(cam)
+    x0, y0, res, rows, cols, z = -12.0, 9.0, 0.37, 23, 31, 1.5
+    for level, origin in ((0, (0, 0)), (1, (7, 3))):
+        mu, mv = plane_map(x0, y0, res, rows, cols, z, im.R, im.C, cam, r2, level, origin)
+        X, Y = np.meshgrid(x0 + (np.arange(cols) + 0.5) * res, y0 - (np.arange(rows) + 0.5) * res)
+        uv = project_points(np.column_stack([X.ravel(), Y.ravel(), np.full(X.size, z)]), im.R, im.C, cam)
+        s = 0.5**level
+        assert np.allclose(mu.ravel(), (uv[:, 0] + 0.5) * s - 0.5 - origin[0], atol=2e-3)
+        assert np.allclose(mv.ravel(), (uv[:, 1] + 0.5) * s - 0.5 - origin[1], atol=2e-3)
+
+
+def test_monotonic_radius_of_a_folding_distortion():
+    from truortho.core.geometry.camera import Camera
+
+    cam = Camera(100, 100, 100.0, 100.0, 50.0, 50.0, k1=-0.3)
+    r2 = monotonic_radius2(cam)  # d/dr (r + k1 r^3) = 1 + 3 k1 r^2 > 0 for r^2 < 1/0.9
+    assert 0.9 < r2 < 1 / 0.9
+    assert monotonic_radius2(Camera(100, 100, 100.0, 100.0, 50.0, 50.0)) == pytest.approx(4.0)
+
+
+def test_level_plan_and_refined_windows():
+    grid = RasterGrid(0.0, 100.0, 0.25, 400, 400)
+    plan = plan_levels(-5.0, 55.0, 0.25, grid)
+    top = plan.levels[0]
+    assert plan.levels == list(range(top, -1, -1)) and top >= 2
+    assert plan.count(top) <= 64 + 1 and plan.z_top >= 55.0
+    # a coarse result with a 10 m step: cells near it search both sides, far cells a narrow band
+    coarse = np.zeros(plan.grid(grid, 1).shape, np.float32)
+    coarse[:, 100:] = 10.0
+    coarse[50, 50] = np.nan
+    lo, hi = refine_windows(plan, 0, coarse, (0, 0, 400, 400))
+    z = lambda a: plan.z_base + a * plan.dz(0)  # noqa: E731
+    assert z(lo[10, 199]) <= 0.0 and z(hi[10, 199]) >= 10.0  # both sides at the step
+    assert z(lo[10, 20]) <= 0.0 <= z(hi[10, 20]) and hi[10, 20] - lo[10, 20] < 30
+    assert z(lo[100, 100]) <= 0.0 <= z(hi[100, 100])  # a hole takes its neighbours' range
+    assert (hi - lo + 1).max() <= MAX_BAND
+
+
+def test_reference_systems_of_an_oblique_block():
+    scene = make_scene(_small_config(n_oblique=8, image_size=(120, 90), focal_px=150.0))
+    o = scene.orientation
+    assert len(reference_systems(o, "none", 35.0)) == 1
+    systems = reference_systems(o, "auto", 35.0)
+    assert 3 <= len(systems) <= 8
+    for s in systems[1:]:
+        assert np.allclose(s.Q @ s.Q.T, np.eye(3), atol=1e-12) and np.linalg.det(s.Q) > 0
+        assert np.allclose(s.Q[2], -s.direction)  # the system's Z looks back at its cameras
+        assert len(s.images) >= 2
+        tilt = math.degrees(math.acos(-s.direction[2]))
+        assert 25 < tilt < 55
+    obliques = {i for s in systems[1:] for i in s.images if i >= scene.n_nadir}
+    assert obliques == set(range(scene.n_nadir, len(o.images)))
+
+
+# ------------------------------------------------------------------ runs
+
+
+@pytest.mark.slow
+def test_osgm_nadir_block_acceptance(tmp_path):
+    cfg = SceneConfig(image_size=(320, 240), focal_px=400.0, seed=1, n_oblique=0)
+    scene = make_scene(cfg)
+    scene.write(tmp_path)
+    gsd = cfg.gsd
+    messages = []
+    out = OsgmOutputs(
+        dsm=tmp_path / "dsm.tif", confidence=tmp_path / "conf.tif", orthoimage=tmp_path / "ortho.tif",
+        point_cloud=tmp_path / "pc.laz",
+    )  # fmt: skip
+    result = run_osgm(scene.orientation, OsgmConfig(resolution=gsd), scene.extent_world(), out, tmp_path,
+                      progress=CallbackProgress(lambda f, m: messages.append(f)))  # fmt: skip
+    dsm, grid, nodata = read_raster(tmp_path / "dsm.tif")
+    assert grid.crs and nodata is not None and grid.res == pytest.approx(gsd)
+    truth, nvis = _truth_and_seen(scene, grid)
+    seen = nvis >= 2
+    e = dsm - truth
+    ok = np.isfinite(e) & seen
+    nmad = 1.4826 * np.median(np.abs(e[ok] - np.median(e[ok])))
+    step = (_maxf(truth, 3) - _minf(truth, 3)) > 1.0  # building outlines (walls), 1 cell
+    edge = _maxf(step.astype(np.uint8), 5).astype(bool)  # within 2 GSD of them
+    good = np.abs(np.nan_to_num(e, nan=1e9)) <= 3 * gsd
+    completeness = ok.sum() / seen.sum()
+    flat, near = good[seen & ~edge].mean(), good[seen & edge].mean()
+    print(
+        f"\nOSGM nadir block ({len(scene.orientation.images)} images, GSD {gsd:.3f} m): "
+        f"NMAD {nmad / gsd:.2f} GSD, completeness {100 * completeness:.2f} % of the "
+        f"{seen.mean() * 100:.1f} % cells seen by >= 2 images, within 3 GSD: {100 * flat:.2f} % away "
+        f"from edges, {100 * near:.2f} % within 2 GSD of building edges; "
+        f"{result.summary()}"
+    )
+    assert nmad <= gsd
+    assert flat >= 0.95
+    assert completeness >= 0.98
+    assert near >= 0.80
+    # the tower (32 m above the terrain) is in the DSM
+    tower = [b for b in scene.surface.buildings if b.tower][0]
+    r, c = (int(round(v)) for v in grid.cell_of(*(np.array(tower.center) + scene.offset[:2])))
+    assert abs(dsm[r, c] - (tower.top + scene.offset[2])) < 3 * gsd
+    # confidence in [0, 1] where the DSM has values; progress reached the end
+    conf, _, _ = read_raster(tmp_path / "conf.tif")
+    assert np.isfinite(conf[np.isfinite(dsm)]).all() and np.nanmin(conf) >= 0 and np.nanmax(conf) <= 1
+    assert messages and messages[-1] == pytest.approx(1.0) and np.all(np.diff(messages) >= -1e-9)
+    # orthoimage by-product: colours of the scene where the DSM is right
+    ortho = np.moveaxis(read_raster(tmp_path / "ortho.tif", band=None)[0], 0, -1)
+    true_rgb, _ = scene.orthophoto(gsd, grid.extent)
+    both = ok & good & ~edge & (ortho.sum(axis=-1) > 0)
+    diff = np.abs(ortho.astype(float) - true_rgb.astype(float)).mean(axis=-1)
+    assert np.median(diff[both]) < 25  # per-image exposure differs by ~10 %; no correction here
+    # point cloud: one point per valid cell, with colours and confidence
+    from truortho.core.surface.pointcloud import read_point_cloud
+
+    pc = read_point_cloud(tmp_path / "pc.laz")
+    assert len(pc) == int(np.isfinite(dsm).sum()) and pc.rgb is not None and pc.confidence is not None
+
+
+def _maxf(a, size):
+    from scipy.ndimage import maximum_filter
+
+    return maximum_filter(a, size)
+
+
+def _minf(a, size):
+    from scipy.ndimage import minimum_filter
+
+    return minimum_filter(a, size)
+
+
+@pytest.mark.slow
+def test_obliques_add_facade_points(tmp_path):
+    from scipy.spatial import cKDTree
+
+    from truortho.core.surface.pointcloud import read_point_cloud
+
+    cfg = SceneConfig(
+        extent=(-35.0, -30.0, 35.0, 30.0), n_buildings=4, tower=False, image_size=(320, 240), focal_px=400.0,
+        seed=2, n_oblique=8,
+    )  # fmt: skip
+    scene = make_scene(cfg)
+    scene.write(tmp_path)
+    res = 2 * cfg.gsd
+    walls = _wall_samples(scene, res / 2)
+    out = {}
+    for mode in ("none", "auto"):
+        r = run_osgm(scene.orientation, OsgmConfig(resolution=res, oblique=mode), scene.extent_world(),
+                     OsgmOutputs(dsm=tmp_path / f"dsm_{mode}.tif", point_cloud=tmp_path / f"pc_{mode}.laz"),
+                     tmp_path)  # fmt: skip
+        pc = read_point_cloud(tmp_path / f"pc_{mode}.laz")
+        d, _ = cKDTree(pc.xyz - scene.offset).query(walls)
+        wd = _wall_distance(scene, pc.xyz - scene.offset)
+        facade = wd < 1.0
+        out[mode] = (np.mean(d <= res), int(facade.sum()), float(np.sqrt(np.mean(wd[facade] ** 2))), pc, r)
+        print(
+            f"\noblique={mode}: {len(r.stats['systems'])} reference system(s), {len(pc)} points; wall area "
+            f"covered (a point within {res:.2f} m): {100 * out[mode][0]:.1f} %; "
+            f"{out[mode][1]} facade points, RMS distance to the true walls {out[mode][2]:.3f} m"
+        )
+    cov_n, fac_n = out["none"][0], out["none"][1]
+    cov_a, fac_a, rms_a, pc, r = out["auto"]
+    assert len(r.stats["systems"]) >= 3
+    assert cov_a >= 0.25 and cov_a >= 4 * cov_n
+    assert fac_a >= 10 * max(fac_n, 1)
+    assert rms_a <= 2 * res
+    assert set(np.unique(pc.system)) >= {0, 1, 2}
+    # the nadir DSM is the same with or without the oblique systems
+    a, _, _ = read_raster(tmp_path / "dsm_auto.tif")
+    b, _, _ = read_raster(tmp_path / "dsm_none.tif")
+    assert np.array_equal(np.isnan(a), np.isnan(b)) and np.nanmax(np.abs(a - b)) == 0
+
+
+def _wall_samples(scene, step):
+    pts = []
+    for b in scene.surface.buildings:
+        c = b.corners()
+        for k in range(4):
+            a, e = c[k], c[(k + 1) % 4]
+            n = max(1, int(np.linalg.norm(e - a) / step))
+            s = (np.arange(n) + 0.5) / n
+            zs = np.arange(b.base + 0.5, b.eave_top - 0.5, step)
+            xy = a + np.outer(s, e - a)
+            pts.append(np.column_stack([np.repeat(xy, len(zs), axis=0), np.tile(zs, len(xy))]))
+    return np.vstack(pts)
+
+
+def _wall_distance(scene, p):
+    """Horizontal distance to the nearest wall, for points between a building's base and eaves (else inf)."""
+    best = np.full(len(p), np.inf)
+    for b in scene.surface.buildings:
+        c = b.corners()
+        zin = (p[:, 2] > b.base + 0.5) & (p[:, 2] < b.eave_top - 0.5)
+        for k in range(4):
+            a, e = c[k], c[(k + 1) % 4]
+            v = e - a
+            L = np.linalg.norm(v)
+            u = v / L
+            q = p[:, :2] - a
+            s = np.clip(q @ u, 0, L)
+            d = np.linalg.norm(q - np.outer(s, u), axis=1)
+            best = np.where(zin, np.minimum(best, d), best)
+    return best
+
+
+def test_tiles_and_16bit_single_band_images(small_scene, tmp_path):
+    """Tile size does not change the result much; 16-bit single-band images match like 8-bit RGB."""
+    scene, folder = small_scene
+    res = 2 * scene.config.gsd
+    ext = scene.extent_world()
+    runs = {}
+    for name, ts in (("t256", 256), ("t48", 48)):
+        run_osgm(scene.orientation, OsgmConfig(resolution=res, tile_size=ts), ext,
+                 OsgmOutputs(dsm=tmp_path / f"{name}.tif"), folder)  # fmt: skip
+        runs[name] = read_raster(tmp_path / f"{name}.tif")[0]
+    grid = read_raster(tmp_path / "t256.tif")[1]
+    truth, nvis = _truth_and_seen(scene, grid)
+    seen = nvis >= 2
+    rates = {}
+    for name, d in runs.items():
+        rates[name] = (np.abs(np.nan_to_num(d - truth, nan=1e9)) <= 3 * res)[seen].mean()
+    agree = (np.abs(np.nan_to_num(runs["t256"] - runs["t48"], nan=1e9)) <= 2 * res)[seen].mean()
+    print(
+        f"\nwithin 3 GSD: tiles of 256 {rates['t256']:.3f}, of 48 {rates['t48']:.3f}; agreement {agree:.3f}"
+    )
+    # SGM paths end at tile borders (16 cells of overlap), so small tiles differ a little, not in quality
+    assert min(rates.values()) > 0.9 and abs(rates["t256"] - rates["t48"]) < 0.02
+    assert agree > 0.9
+    # 16-bit grey copies of the images
+    grey = tmp_path / "grey"
+    grey.mkdir()
+    for im, arr in zip(scene.orientation.images, scene.images, strict=True):
+        g16 = (cv2.cvtColor(arr, cv2.COLOR_RGB2GRAY).astype(np.uint16) * 257).astype(np.uint16)
+        cv2.imwrite(str(grey / im.name), g16)
+    run_osgm(scene.orientation, OsgmConfig(resolution=res), ext, OsgmOutputs(dsm=tmp_path / "g.tif",
+             orthoimage=tmp_path / "go.tif"), grey)  # fmt: skip
+    g = read_raster(tmp_path / "g.tif")[0]
+    good = np.abs(np.nan_to_num(g - truth, nan=1e9)) <= 3 * res
+    assert good[seen].mean() > 0.9
+
+
+def test_bad_input_and_cancel(small_scene, tmp_path):
+    import dataclasses
+
+    scene, folder = small_scene
+    o = scene.orientation
+    res = 2 * scene.config.gsd
+    out = OsgmOutputs(dsm=tmp_path / "d.tif")
+    with pytest.raises(InputError, match="Z_MIN"):
+        run_osgm(o, OsgmConfig(z_min=10.0, z_max=5.0), None, out, folder)
+    with pytest.raises(InputError, match="POINT_CLOUD"):
+        run_osgm(
+            o, OsgmConfig(), None, OsgmOutputs(dsm=tmp_path / "d.tif", point_cloud=tmp_path / "p.txt"), folder
+        )
+    x0, y0, x1, y1 = scene.extent_world()
+    with pytest.raises(InputError, match="EXTENT"):
+        run_osgm(o, OsgmConfig(resolution=res), (x0 + 5000, y0, x1 + 5000, y1), out, folder)
+    bare = dataclasses.replace(o, gcps=[], points=None)
+    with pytest.raises(InputError, match="Z_MIN/Z_MAX"):
+        run_osgm(bare, OsgmConfig(resolution=res), None, out, folder)
+    with pytest.raises(MissingFileError):
+        run_osgm(o, OsgmConfig(resolution=res), None, out, tmp_path / "nowhere")
+    with pytest.raises(InputError, match="P1, P2"):
+        run_osgm(o, OsgmConfig(p1=500, p2=400), None, out, folder)
+    # a Z_SURFACE alone gives the range when the block has no heights
+    from truortho.core.rasterio_io import write_raster
+
+    grid = RasterGrid.from_extent(scene.extent_world(), 1.0, o.crs)
+    truth, _ = _truth_and_seen(scene, grid)
+    write_raster(tmp_path / "coarse.tif", truth.astype(np.float32), grid, nodata=-9999.0)
+    r = run_osgm(
+        bare, OsgmConfig(resolution=res), scene.extent_world(), out, folder, z_surface=tmp_path / "coarse.tif"
+    )
+    assert r.stats["z_source"] == "Z_SURFACE" and (tmp_path / "d.tif").exists()
+    (tmp_path / "d.tif").unlink()
+    # cancel: nothing written
+    calls = []
+
+    def cancelled():
+        calls.append(1)
+        return len(calls) > 3
+
+    with pytest.raises(CancelledError):
+        outs = OsgmOutputs(dsm=tmp_path / "c.tif", confidence=tmp_path / "cc.tif")
+        run_osgm(
+            o, OsgmConfig(resolution=res), None, outs, folder, progress=CallbackProgress(None, cancelled)
+        )
+    assert not list(tmp_path.glob("c.tif*")) and not list(tmp_path.glob("cc.tif*"))
