@@ -9,6 +9,7 @@
 #   3. .venv/qgis-plugins/truortho -> repository root, and a .pth file so that
 #      `import truortho` works in the venv python.
 #   4. An isolated QGIS profile (.venv/qgis-config) with the plugin enabled.
+#   5. i18n/*.qm compiled from i18n/*.ts (when a .ts is newer) for the plugin in the tree.
 #
 # Re-running it when nothing changed does nothing and takes a few seconds.
 set -euo pipefail
@@ -23,7 +24,7 @@ APT_PACKAGES=(
     gdal-bin python3-gdal
     python3-venv python3-rasterio python3-pyproj python3-shapely
     python3-scipy python3-matplotlib python3-pil
-    xvfb qttools5-dev-tools
+    xvfb qttools5-dev-tools time
 )
 
 # --- 1. Debian packages ------------------------------------------------------
@@ -96,5 +97,17 @@ if ! grep -qs '^truortho=true' "$ini"; then
     }
     grep -qs '^truortho=true' "$ini" || { log "plugin not enabled in $ini"; exit 1; }
 fi
+
+# --- 5. translations for the plugin running from this tree -------------------
+# i18n/*.ts -> i18n/*.qm (build products, git-ignored) when the .ts is newer than its .qm.
+LRELEASE=/usr/lib/qt5/bin/lrelease
+[[ -x "$LRELEASE" ]] || LRELEASE="$(command -v lrelease || command -v lrelease-qt5 || true)"
+for ts in "$ROOT"/i18n/*.ts; do
+    [[ -e "$ts" ]] || continue
+    qm="${ts%.ts}.qm"
+    [[ -e "$qm" && ! "$ts" -nt "$qm" ]] && continue
+    if [[ -z "$LRELEASE" ]]; then log "lrelease not found: $(basename "$ts") not compiled"; continue; fi
+    "$LRELEASE" -silent "$ts" -qm "$qm"
+done
 
 log "ok ($(cd "$ROOT" && "$VENV/bin/python" -c 'import truortho, sys; print(truortho.__file__)'))"

@@ -1,0 +1,186 @@
+"""``truortho:pipeline``: photos (+ GCPs) -> orientation, DSM, point cloud, mesh, true orthophoto, report."""
+
+from __future__ import annotations
+
+import os
+
+from qgis.core import (
+    QgsProcessing,
+    QgsProcessingContext,
+    QgsProcessingException,
+    QgsProcessingOutputFile,
+    QgsProcessingOutputRasterLayer,
+    QgsProcessingOutputVectorLayer,
+    QgsProcessingParameterBoolean,
+    QgsProcessingParameterCrs,
+    QgsProcessingParameterFile,
+    QgsProcessingParameterFolderDestination,
+    QgsProcessingParameterNumber,
+    QgsProcessingParameterVectorLayer,
+)
+
+from ..feedback import FeedbackProgress, core_errors
+from ..i18n import tr
+from ..layers import crs_text, read_gcp_layer, read_observation_table
+from .base import TruOrthoAlgorithm
+
+
+class PipelineAlgorithm(TruOrthoAlgorithm):
+    NAME = "pipeline"
+    DISPLAY_NAME = "Photos to true orthophoto (whole pipeline)"
+    GROUP_ID = "orthophoto"
+
+    IMAGES = "IMAGES"
+    CAMERA = "CAMERA"
+    GCPS = "GCPS"
+    OBSERVATIONS = "OBSERVATIONS"
+    CRS = "CRS"
+    RESOLUTION = "RESOLUTION"
+    REUSE_ORIENTATION = "REUSE_ORIENTATION"
+    OUTPUT_FOLDER = "OUTPUT_FOLDER"
+    # outputs (files named in truortho.core.workflow.PRODUCTS)
+    OUTPUTS = {
+        "ORIENTATION": "orientation",
+        "REPORT": "report",
+        "DSM": "dsm",
+        "POINT_CLOUD": "pointcloud",
+        "MESH": "mesh",
+        "TRUE_ORTHO": "trueortho",
+        "OCCLUSION": "occlusion",
+        "SEAMLINES": "seamlines",
+    }
+
+    def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
+        self.add(
+            QgsProcessingParameterFile(
+                self.IMAGES, tr("Image folder"), behavior=QgsProcessingParameterFile.Folder, optional=True
+            )
+        )
+        self.add(
+            QgsProcessingParameterFile(
+                self.CAMERA, tr("Interior orientation file (optional)"), optional=True
+            ),
+            advanced=True,
+        )
+        self.add(
+            QgsProcessingParameterVectorLayer(
+                self.GCPS, tr("Ground control points"), [QgsProcessing.TypeVectorPoint], optional=True
+            )
+        )
+        self.add(
+            QgsProcessingParameterVectorLayer(
+                self.OBSERVATIONS,
+                tr("GCP image measurements (table)"),
+                [QgsProcessing.TypeVector],
+                optional=True,
+            )
+        )
+        self.add(QgsProcessingParameterCrs(self.CRS, tr("Output CRS"), optional=True))
+        self.add(
+            QgsProcessingParameterNumber(
+                self.RESOLUTION,
+                tr("Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)"),
+                QgsProcessingParameterNumber.Double,
+                0.0,
+                minValue=0.0,
+            )
+        )
+        self.add(
+            QgsProcessingParameterBoolean(
+                self.REUSE_ORIENTATION, tr("Reuse an existing orientation.json in the output folder"), False
+            )
+        )
+        self.add(QgsProcessingParameterFolderDestination(self.OUTPUT_FOLDER, tr("Output folder")))
+        names = {
+            "ORIENTATION": tr("Orientation (JSON)"),
+            "REPORT": tr("Report (HTML)"),
+            "DSM": tr("DSM (filtered)"),
+            "POINT_CLOUD": tr("Point cloud"),
+            "MESH": tr("Mesh"),
+            "TRUE_ORTHO": tr("True orthophoto"),
+            "OCCLUSION": tr("Occlusion mask"),
+            "SEAMLINES": tr("Seamlines"),
+        }
+        for key, label in names.items():
+            if key in ("DSM", "TRUE_ORTHO", "OCCLUSION"):
+                self.addOutput(QgsProcessingOutputRasterLayer(key, label))
+            elif key == "SEAMLINES":
+                self.addOutput(QgsProcessingOutputVectorLayer(key, label, QgsProcessing.TypeVectorPolygon))
+            else:
+                self.addOutput(QgsProcessingOutputFile(key, label))
+
+    def _images(self, parameters, context, reuse: bool, folder_out: str) -> list[str]:
+        folder = self.parameterAsFile(parameters, self.IMAGES, context)
+        if not folder:
+            if reuse and os.path.exists(os.path.join(folder_out, "orientation.json")):
+                return []
+            raise QgsProcessingException(tr("IMAGES: give the folder of the photos"))
+        if not os.path.isdir(folder):
+            raise QgsProcessingException(tr("IMAGES: {} is not a folder").format(folder))
+        return [
+            os.path.join(folder, n)
+            for n in sorted(os.listdir(folder))
+            if os.path.isfile(os.path.join(folder, n))
+        ]
+
+    @core_errors()
+    def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 - QGIS API
+        from ...core.workflow import WorkflowConfig, run_workflow
+
+        out_folder = self.parameterAsString(parameters, self.OUTPUT_FOLDER, context)
+        if not out_folder:
+            raise QgsProcessingException(tr("OUTPUT_FOLDER: give a folder for the products"))
+        out_folder = self.parameterAsFileOutput(parameters, self.OUTPUT_FOLDER, context) or out_folder
+        reuse = self.parameterAsBool(parameters, self.REUSE_ORIENTATION, context)
+        images = self._images(parameters, context, reuse, out_folder)
+        crs = self.parameterAsCrs(parameters, self.CRS, context)
+        gcp_layer = self.parameterAsVectorLayer(parameters, self.GCPS, context)
+        obs_layer = self.parameterAsVectorLayer(parameters, self.OBSERVATIONS, context)
+        if (gcp_layer is None) != (obs_layer is None):
+            raise QgsProcessingException(tr("GCPS and OBSERVATIONS must be given together"))
+        gcps = []
+        if gcp_layer is not None:
+            if not crs.isValid():
+                crs = gcp_layer.crs()
+            gcps = read_gcp_layer(gcp_layer, crs, context.transformContext())
+            read_observation_table(obs_layer, gcps, None)
+        res = self.parameterAsDouble(parameters, self.RESOLUTION, context)
+        if res < 0:
+            raise QgsProcessingException(tr("RESOLUTION: expected a positive number of metres or 0"))
+        cfg = WorkflowConfig(
+            resolution=res if res > 0 else None,
+            camera_file=self.parameterAsFile(parameters, self.CAMERA, context) or None,
+            reuse_orientation=reuse,
+        )
+        run = run_workflow(
+            images,
+            out_folder,
+            gcps,
+            crs_text(crs) if crs.isValid() else None,
+            cfg,
+            FeedbackProgress(feedback),
+        )
+        for row in run.stats["stages"]:
+            feedback.pushInfo(tr("{}: {:.1f} s, peak {:.0f} MB; {}").format(row[0], row[1], row[2], row[3]))
+        results = {key: run.paths[prod] for key, prod in self.OUTPUTS.items()}
+        results[self.OUTPUT_FOLDER] = out_folder
+        self._load(context, results)
+        return results
+
+    def _load(self, context, results) -> None:
+        """In the GUI: load the DSM (hillshade), the true orthophoto, the occlusion mask and the seamlines."""
+        from ..styles import style_on_load
+
+        project = context.project()
+        if project is None:
+            return
+        for key, kind, name in (
+            ("DSM", "dsm", tr("DSM (TruOrtho)")),
+            ("TRUE_ORTHO", "ortho", tr("True orthophoto (TruOrtho)")),
+            ("OCCLUSION", "occlusion", tr("Occlusion (TruOrtho)")),
+            ("SEAMLINES", None, tr("Seamlines (TruOrtho)")),
+        ):
+            path = results[key]
+            context.addLayerToLoadOnCompletion(path, QgsProcessingContext.LayerDetails(name, project, key))
+            if kind is not None:
+                style_on_load(context, path, kind, name)

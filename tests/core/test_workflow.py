@@ -1,0 +1,69 @@
+"""The end-to-end chain (core/workflow.py) from an existing orientation: OSGM, filter, mesh, true ortho."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from truortho.core.errors import InputError
+from truortho.core.rasterio_io import read_raster
+from truortho.core.synthetic import SceneConfig, make_scene
+from truortho.core.workflow import PRODUCTS, WorkflowConfig, run_workflow
+
+
+@pytest.mark.slow
+def test_workflow_products_and_report_from_a_reused_orientation(tmp_path):
+    cfg = SceneConfig(
+        extent=(-20.0, -15.0, 20.0, 15.0), n_buildings=2, building_size=(7.0, 11.0), building_gap=3.0,
+        tower=False, image_size=(240, 180), focal_px=300.0, n_oblique=0, seed=5,
+    )  # fmt: skip
+    scene = make_scene(cfg)
+    scene.write(tmp_path / "block")
+    out = tmp_path / "products"
+    out.mkdir()
+    o = scene.orientation
+    o.image_root = str((tmp_path / "block").resolve())
+    o.save(out / "orientation.json")
+    res = 2 * cfg.gsd
+    fractions = []
+    r = run_workflow(
+        [], out, config=WorkflowConfig(resolution=res, reuse_orientation=True),
+        progress=__import__("truortho.core.progress", fromlist=["CallbackProgress"]).CallbackProgress(
+            lambda f, m: fractions.append(f)
+        ),
+    )  # fmt: skip
+    for key, name in PRODUCTS.items():
+        assert (out / name).exists(), key
+        assert r.paths[key] == str(out / name)
+    dsm, grid, nodata = read_raster(out / "dsm.tif")
+    X, Y = grid.centres()
+    truth = scene.height(np.column_stack([X.ravel(), Y.ravel()])).reshape(grid.shape)
+    ok = np.isfinite(dsm)
+    assert ok.mean() > 0.7 and np.median(np.abs(dsm[ok] - truth[ok])) < res
+    ortho, og, _ = read_raster(out / "trueortho.tif", band=None)
+    assert ortho.shape[0] == 4 and og.crs and (ortho[3] > 0).mean() > 0.5
+    rep = json.loads((out / "report.json").read_text())
+    assert rep["summary"]["images oriented"] == len(o.images)
+    stages = [t for t in rep["tables"] if t["title"] == "Stages"][0]["rows"]
+    assert [s[0] for s in stages][:5] == [
+        "orientation", "dense matching (OSGM)", "DSM filter", "mesh", "true orthophoto",
+    ]  # fmt: skip
+    assert all(s[1] >= 0 and s[2] > 0 for s in stages)
+    html = (out / "report.html").read_text()
+    assert html.count("data:image/png;base64,") >= 2  # offline: images embedded, nothing linked
+    assert "src='http" not in html and 'src="http' not in html and "<link" not in html
+    assert "reused" in html
+    assert fractions[-1] == pytest.approx(1.0)
+    from osgeo import ogr
+
+    ds = ogr.Open(str(out / "seamlines.gpkg"))
+    assert ds.GetLayer(0).GetFeatureCount() >= 2
+
+
+def test_workflow_bad_input(tmp_path):
+    with pytest.raises(InputError, match="IMAGES"):
+        run_workflow([], tmp_path)
+    with pytest.raises(InputError, match="RESOLUTION"):
+        run_workflow(["x.jpg"], tmp_path, config=WorkflowConfig(resolution=-1.0))
