@@ -13,10 +13,12 @@ from .importorientation import ImportOrientationAlgorithm
 from .mesh import MeshAlgorithm
 from .orientimages import OrientImagesAlgorithm
 from .osgm import OsgmAlgorithm
+from .pipeline import PipelineAlgorithm
 from .pointcloud import DsmToPointCloudAlgorithm, MergePointCloudsAlgorithm
 from .trueortho import TrueOrthoAlgorithm
 
 ALGORITHMS: list[type] = [
+    PipelineAlgorithm,
     EnvironmentAlgorithm,
     ImportOrientationAlgorithm,
     ExportOrientationAlgorithm,

@@ -108,6 +108,41 @@ HELP: dict[str, dict] = {
             "surveyed).",
         },
     },
+    "pipeline": {
+        "summary": (
+            "The whole chain from photos to a true orthophoto in one run: image orientation with the "
+            "ground control (bundle block adjustment), dense matching in object space (OSGM), DSM "
+            "filtering, a mesh, and the true orthophoto with its occlusion mask and seamlines, plus one "
+            "HTML report (block overview, sigma0, GCP and check point tables, residual plot, DSM "
+            "hillshade, true-orthophoto preview, time and memory per stage). The products are written "
+            "to OUTPUT_FOLDER with fixed names: orientation.json, report.html, dsm.tif, pointcloud.laz, "
+            "mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (and the raw DSM, confidence and "
+            "orthoimage of the matching)."
+        ),
+        "parameters": {
+            "IMAGES": "Folder of the photos (JPEG, TIFF, PNG...); other files are skipped.",
+            "CAMERA": "Optional interior orientation (Orthority YAML/JSON or a 3x3 K text file), held "
+            "fixed; otherwise EXIF priors refined by self-calibration.",
+            "GCPS": "Optional point layer of ground control and check points (fields name, role "
+            "gcp|check, optional z, sigma_xy, sigma_z), as for Orient images. Needed for a georeferenced "
+            "product unless the photos carry EXIF GNSS positions.",
+            "OBSERVATIONS": "Table of the GCP image measurements (gcp, image, x, y), given with GCPS.",
+            "CRS": "CRS of the products; default the GCP layer's CRS.",
+            "RESOLUTION": "Cell size of the DSM and the true orthophoto in metres; 0 = the median ground "
+            "sample distance of the near-nadir images.",
+            "REUSE_ORIENTATION": "Skip the orientation when OUTPUT_FOLDER already holds orientation.json "
+            "(e.g. to rerun matching and the orthophoto with another resolution).",
+            "OUTPUT_FOLDER": "Folder of the products (created when missing; existing products are replaced).",
+            "ORIENTATION": "orientation.json: the adjusted orientation.",
+            "REPORT": "report.html (and report.json): the quality report of the run.",
+            "DSM": "dsm.tif: the filtered DSM (float32, nodata -9999).",
+            "POINT_CLOUD": "pointcloud.laz: the matched points with colour and confidence.",
+            "MESH": "mesh.ply: 2.5D mesh of the filtered DSM with vertical walls and vertex colours.",
+            "TRUE_ORTHO": "trueortho.tif: the true orthophoto (bands of the photos + alpha, COG).",
+            "OCCLUSION": "occlusion.tif: 1 where no photo sees the surface.",
+            "SEAMLINES": "seamlines.gpkg: one polygon per source photo.",
+        },
+    },
     "osgm": {
         "summary": (
             "Dense image matching in object space (OSGM): computes a DSM directly on a ground grid from "
