@@ -39,8 +39,8 @@ EXCLUDE_TOP = {
     ".gitignore",
     ".gitattributes",
 }
-#: Glob patterns never shipped (anywhere).
-EXCLUDE_GLOBS = ("*.pyc", "*/__pycache__/*", "*.ts", "*.pro", ".*")
+#: Glob patterns never shipped (anywhere); ``.qm`` files are compiled afresh (a tree's own may be stale).
+EXCLUDE_GLOBS = ("*.pyc", "*/__pycache__/*", "*.ts", "*.qm", "*.pro", ".*")
 #: Sample folders (under sample/) that the zip keeps.
 SAMPLE_KEEP = ("copr", "synthetic")
 #: Fixed timestamp of every entry (reproducible archives).

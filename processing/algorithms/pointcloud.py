@@ -18,7 +18,13 @@ from ..i18n import tr
 from .base import TruOrthoAlgorithm
 from .dsmfilter import _optional_number
 
+#: File filter of LAS/LAZ outputs (the source text of :func:`las_filter`'s translation).
 LAS_FILTER = "LAZ (compressed) (*.laz);;LAS (*.las)"
+
+
+def las_filter() -> str:
+    """``LAS_FILTER``, translated (a literal ``tr()`` so that scripts/i18n_update.py collects it)."""
+    return tr("LAZ (compressed) (*.laz);;LAS (*.las)")
 
 
 def _ept_folder(alg, parameters, name, context) -> str | None:
@@ -49,7 +55,7 @@ class DsmToPointCloudAlgorithm(TruOrthoAlgorithm):
         self.add(
             QgsProcessingParameterRasterLayer(self.CONFIDENCE, tr("Confidence raster [0, 1]"), optional=True)
         )
-        self.add(QgsProcessingParameterFileDestination(self.OUTPUT, tr("Point cloud"), tr(LAS_FILTER)))
+        self.add(QgsProcessingParameterFileDestination(self.OUTPUT, tr("Point cloud"), las_filter()))
         self.add(
             QgsProcessingParameterFolderDestination(
                 self.EPT,
@@ -112,7 +118,7 @@ class MergePointCloudsAlgorithm(TruOrthoAlgorithm):
                 minValue=0.0,
             )
         )
-        self.add(QgsProcessingParameterFileDestination(self.OUTPUT, tr("Merged point cloud"), tr(LAS_FILTER)))
+        self.add(QgsProcessingParameterFileDestination(self.OUTPUT, tr("Merged point cloud"), las_filter()))
         self.add(
             QgsProcessingParameterFolderDestination(
                 self.EPT,
