@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import os
 
-from qgis.core import QgsMessageLog, QgsProcessingProvider
+from qgis.core import QgsApplication, QgsMessageLog, QgsProcessingModelAlgorithm, QgsProcessingProvider
 from qgis.PyQt.QtGui import QIcon
 
 from .i18n import tr
 
 PLUGIN_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 ICON_PATH = os.path.join(PLUGIN_DIR, "icon.png")
+MODELS_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "models")
 
 
 def _version() -> str:
@@ -60,3 +61,32 @@ class TruOrthoProvider(QgsProcessingProvider):
             return
         for cls in ALGORITHMS:
             self.addAlgorithm(cls())
+        self._load_models()
+
+    def _load_models(self) -> None:
+        """The Processing models shipped in ``processing/models/*.model3`` (ids ``truortho:<name>``)."""
+        try:
+            names = sorted(n for n in os.listdir(MODELS_DIR) if n.endswith(".model3"))
+        except OSError:
+            return
+        for name in names:
+            model = QgsProcessingModelAlgorithm()
+            if model.fromFile(os.path.join(MODELS_DIR, name)):
+                self.addAlgorithm(model)
+            else:
+                QgsMessageLog.logMessage(tr("TruOrtho model {} could not be loaded").format(name), "TruOrtho")
+        registry = QgsApplication.processingRegistry()
+        if names and registry.providerById(self.id()) is None:
+            # First load (inside addProvider): the models' child algorithms (truortho:*) are not in
+            # the registry yet, so attach them once this provider is registered.
+            registry.providerAdded.connect(self._attach_models)
+
+    def _attach_models(self, provider_id: str) -> None:
+        if provider_id != self.id():
+            return
+        QgsApplication.processingRegistry().providerAdded.disconnect(self._attach_models)
+        for alg in self.algorithms():
+            if isinstance(alg, QgsProcessingModelAlgorithm):
+                for child_id in alg.childAlgorithms():
+                    alg.childAlgorithm(child_id).reattach()
+                alg.updateDestinationParameters()
