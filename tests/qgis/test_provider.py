@@ -28,10 +28,15 @@ def test_provider_registered(truortho_provider):
 
 
 def test_algorithms_list_matches_provider(truortho_provider):
+    import os
+
     from truortho.processing.algorithms import ALGORITHMS
+    from truortho.processing.provider import MODELS_DIR
 
     ids = {alg.id() for alg in truortho_provider.algorithms()}
-    assert ids == {f"truortho:{cls().name()}" for cls in ALGORITHMS}
+    models = {f"truortho:{n[: -len('.model3')]}" for n in os.listdir(MODELS_DIR) if n.endswith(".model3")}
+    assert models  # the shipped model (processing/models/) is an algorithm of the provider
+    assert ids == {f"truortho:{cls().name()}" for cls in ALGORITHMS} | models
 
 
 def test_unload_removes_and_init_readds(truortho_plugin):
