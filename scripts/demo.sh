@@ -11,7 +11,7 @@ set -euo pipefail
 ROOT="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 SAMPLE="$ROOT/sample/copr"
 OUT="${TRUORTHO_DEMO_OUT:-$ROOT/build/demo}"
-RES="${TRUORTHO_DEMO_RES:-0.05}"
+RES="${TRUORTHO_DEMO_RES:-0.1}"
 QP="$ROOT/scripts/qgis_process"
 rm -rf "$OUT"
 mkdir -p "$OUT"

@@ -28,7 +28,7 @@ import numpy as np
 from ..errors import InputError
 from ..geometry.camera import Camera, _distort_one
 from ..imagery import _read_rasterio, _use_rasterio, image_info, luminance, read_image
-from ..jit import njit, pjit, prange
+from ..jit import njit
 
 
 def monotonic_radius2(camera: Camera, limit: float = 4.0) -> float:
@@ -42,10 +42,10 @@ def monotonic_radius2(camera: Camera, limit: float = 4.0) -> float:
     return float(rmax * rmax)
 
 
-@pjit
+@njit
 def _plane_map(x0, y0, res, rows, cols, z, R, C, p, r2max, scale, shift_u, shift_v, mu, mv):
     """Pixel coordinates (at a pyramid level, minus a window origin) of cell centres at height z."""
-    for r in prange(rows):
+    for r in range(rows):
         Y = y0 - (r + 0.5) * res
         for c in range(cols):
             X = x0 + (c + 0.5) * res
