@@ -170,3 +170,28 @@ def test_model_runs_whole_chain(block, tmp_path):
 
     cloud = read_point_cloud(str(out["osgm:pointcloud"]))
     assert len(cloud.xyz) > 1000
+    # the same inputs through truortho:pipeline give the same products
+    pipe = tmp_path / "pipeline"
+    proc = _run_qgis_process(
+        "run", "truortho:pipeline", "--", f"IMAGES={root / 'images'}", f"GCPS={root / 'gcps.gpkg'}",
+        f"OBSERVATIONS={root / 'observations.gpkg'}", f"CRS={crs}", f"RESOLUTION={RES}",
+        f"OUTPUT_FOLDER={pipe}",
+        timeout=900,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    from truortho.core.orientation import Orientation
+
+    om, op = Orientation.load(out["orientimages:orientation"]), Orientation.load(pipe / "orientation.json")
+    assert [im.name for im in om.images] == [im.name for im in op.images]
+    assert np.abs(om.world_centers() - op.world_centers()).max() < 1e-6
+    pairs = (
+        ("dsmfilter:dsm", "dsm.tif"),
+        ("trueortho:trueortho", "trueortho.tif"),
+        ("trueortho:occlusion", "occlusion.tif"),
+    )
+    for name, fname in pairs:
+        with rasterio.open(out[name]) as a, rasterio.open(pipe / fname) as b:
+            assert a.transform == b.transform and a.crs == b.crs
+            da, db = a.read(masked=True), b.read(masked=True)
+            assert np.array_equal(da.mask, db.mask), name
+            assert np.allclose(da.filled(0), db.filled(0), atol=1e-4), name
