@@ -38,6 +38,15 @@ def test_action_opens_the_processing_dialog(gui_plugin, monkeypatch):
     assert opened == ["truortho:orientimages"]
 
 
+def test_toolbar_button_opens_the_pipeline(gui_plugin, monkeypatch):
+    import processing
+
+    opened = []
+    monkeypatch.setattr(processing, "execAlgorithmDialog", lambda alg, params: opened.append(alg) or {})
+    gui_plugin.toolbar.actions()[0].trigger()
+    assert opened == ["truortho:pipeline"]
+
+
 def test_unavailable_algorithm_warns_instead_of_failing(gui_plugin, qgis_iface, monkeypatch):
     import processing
 
