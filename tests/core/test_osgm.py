@@ -361,3 +361,30 @@ def test_bad_input_and_cancel(small_scene, tmp_path):
             o, OsgmConfig(resolution=res), None, outs, folder, progress=CallbackProgress(None, cancelled)
         )
     assert not list(tmp_path.glob("c.tif*")) and not list(tmp_path.glob("cc.tif*"))
+
+
+def test_image_windows_from_tiled_tiff_match_the_decoded_image(small_scene, tmp_path):
+    """Large rasters are read by windows (rasterio, reduced levels from overviews or decimation)."""
+    import rasterio
+
+    from truortho.core.osgm.views import ImagePyramid
+
+    scene, folder = small_scene
+    img = scene.images[0]
+    h, w = img.shape[:2]
+    tif = tmp_path / "big.tif"
+    with rasterio.open(tif, "w", driver="GTiff", width=w, height=h, count=3, dtype="uint8", tiled=True,
+                       blockxsize=64, blockysize=64) as ds:  # fmt: skip
+        ds.write(np.moveaxis(img, -1, 0))
+    png = folder / scene.orientation.images[0].name
+    windowed = ImagePyramid([str(tif)], [(w, h)])
+    decoded = ImagePyramid([str(png)], [(w, h)])
+    assert windowed._windowed[0] and not decoded._windowed[0]
+    for level, (x0, y0, ww, hh) in ((0, (-5, 10, 70, 50)), (1, (20, -3, 40, 30)), (2, (3, 4, 30, 25))):
+        a = windowed.window(0, level, x0, y0, ww, hh)
+        b = decoded.window(0, level, x0, y0, ww, hh)
+        assert np.array_equal(np.isnan(a), np.isnan(b))
+        ok = np.isfinite(a)
+        tol = 1e-6 if level == 0 else 0.02  # GDAL's average vs OpenCV's area halvings
+        assert np.abs(a[ok] - b[ok]).mean() < tol, level
+    assert windowed.reads == 3  # one windowed read per request, never the whole image
