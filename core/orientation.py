@@ -513,3 +513,12 @@ def _from_dict(d: object, source: str, base_dir: str | None) -> Orientation:
     except InputError as err:
         raise FormatError(source, str(err)) from None
     return o
+
+
+def as_orientation(orientation, name: str = "ORIENTATION") -> Orientation:
+    """An :class:`Orientation` given as itself or as the path of its JSON file."""
+    if isinstance(orientation, Orientation):
+        return orientation
+    if isinstance(orientation, str | os.PathLike):
+        return Orientation.load(orientation)
+    raise InputError(f"{name}: expected an orientation file or object, got {type(orientation).__name__}")

@@ -329,3 +329,23 @@ def read_observation_table(layer, gcps: list[GCP], image_names: set[str] | None 
                 tr("Observation table {!r}, feature {}: x and y are required").format(layer.name(), feat.id())
             )
         by_name[gname].observations.append((image, x, y))
+
+
+def ground_control(gcp_layer, obs_layer, crs, transform_context):
+    """GCP records (with their image measurements) from the GCPS layer and the OBSERVATIONS table.
+
+    ``crs``: the requested output CRS (invalid = none); the GCPs are reprojected into it, or it
+    becomes the GCP layer's CRS. Returns ``(gcps, crs)``; no layers gives ``([], crs)``.
+    Raises ``QgsProcessingException`` when only one of the two layers is given.
+    """
+    from qgis.core import QgsProcessingException
+
+    if (gcp_layer is None) != (obs_layer is None):
+        raise QgsProcessingException(tr("GCPS and OBSERVATIONS must be given together"))
+    if gcp_layer is None:
+        return [], crs
+    if not crs.isValid():
+        crs = gcp_layer.crs()
+    gcps = read_gcp_layer(gcp_layer, crs, transform_context)
+    read_observation_table(obs_layer, gcps, None)
+    return gcps, crs

@@ -42,7 +42,7 @@ import numpy as np
 from ..errors import CRSError, InputError, MissingFileError
 from ..grid import RasterGrid
 from ..imagery import image_info
-from ..orientation import Orientation
+from ..orientation import Orientation, as_orientation
 from ..progress import Progress, Steps, as_progress, check
 from .color import ColorCorrection, estimate_corrections, to_channels
 from .mosaic import ImageStore, MosaicParams, candidate_colours, mosaic_tile, to_dtype
@@ -178,11 +178,7 @@ class TrueOrthoResult:
 
 
 def _load_orientation(orientation) -> Orientation:
-    if isinstance(orientation, Orientation):
-        return orientation
-    if isinstance(orientation, str | os.PathLike):
-        return Orientation.load(orientation)
-    raise InputError(f"ORIENTATION: expected an orientation file or object, got {type(orientation).__name__}")
+    return as_orientation(orientation)
 
 
 def _default_resolution(surface, orientation: Orientation, out_crs) -> float:

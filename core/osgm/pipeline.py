@@ -35,7 +35,7 @@ import numpy as np
 from ..errors import CancelledError, InputError
 from ..geometry.frame import parse_crs, require_metric
 from ..grid import RasterGrid
-from ..orientation import Orientation
+from ..orientation import Orientation, as_orientation
 from ..progress import Progress, as_progress
 from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
 from .levels import LevelPlan, coarse_windows, plan_levels, refine_windows
@@ -263,11 +263,7 @@ def _system_views(orientation: Orientation, system: RefSystem) -> list[View]:
 
 
 def _load(orientation) -> Orientation:
-    if isinstance(orientation, Orientation):
-        return orientation
-    if isinstance(orientation, str | os.PathLike):
-        return Orientation.load(orientation)
-    raise InputError(f"ORIENTATION: expected an orientation file or object, got {type(orientation).__name__}")
+    return as_orientation(orientation)
 
 
 def _known_heights(o: Orientation) -> np.ndarray:

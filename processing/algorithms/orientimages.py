@@ -27,7 +27,7 @@ from qgis.PyQt.QtCore import QVariant
 
 from ..feedback import FeedbackProgress, core_errors
 from ..i18n import tr
-from ..layers import camera_features, camera_fields, crs_text, qgs_crs, read_gcp_layer, read_observation_table
+from ..layers import camera_features, camera_fields, crs_text, ground_control, qgs_crs
 from .base import TruOrthoAlgorithm
 
 
@@ -177,15 +177,8 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
         crs = self.parameterAsCrs(parameters, self.CRS, context)
         gcp_layer = self.parameterAsVectorLayer(parameters, self.GCPS, context)
         obs_layer = self.parameterAsVectorLayer(parameters, self.OBSERVATIONS, context)
-        if (gcp_layer is None) != (obs_layer is None):
-            raise QgsProcessingException(tr("GCPS and OBSERVATIONS must be given together"))
-        gcps = []
-        if gcp_layer is not None:
-            target = crs if crs.isValid() else gcp_layer.crs()
-            if not crs.isValid():
-                crs = gcp_layer.crs()
-            gcps = read_gcp_layer(gcp_layer, target, context.transformContext())
-            read_observation_table(obs_layer, gcps, None)
+        gcps, crs = ground_control(gcp_layer, obs_layer, crs, context.transformContext())
+        if gcps:
             feedback.pushInfo(
                 tr("{} control and {} check points").format(
                     sum(g.role == "gcp" for g in gcps), sum(g.role == "check" for g in gcps)

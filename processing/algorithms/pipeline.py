@@ -21,7 +21,7 @@ from qgis.core import (
 
 from ..feedback import FeedbackProgress, core_errors
 from ..i18n import tr
-from ..layers import crs_text, read_gcp_layer, read_observation_table
+from ..layers import crs_text, ground_control
 from .base import TruOrthoAlgorithm
 
 
@@ -136,14 +136,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         crs = self.parameterAsCrs(parameters, self.CRS, context)
         gcp_layer = self.parameterAsVectorLayer(parameters, self.GCPS, context)
         obs_layer = self.parameterAsVectorLayer(parameters, self.OBSERVATIONS, context)
-        if (gcp_layer is None) != (obs_layer is None):
-            raise QgsProcessingException(tr("GCPS and OBSERVATIONS must be given together"))
-        gcps = []
-        if gcp_layer is not None:
-            if not crs.isValid():
-                crs = gcp_layer.crs()
-            gcps = read_gcp_layer(gcp_layer, crs, context.transformContext())
-            read_observation_table(obs_layer, gcps, None)
+        gcps, crs = ground_control(gcp_layer, obs_layer, crs, context.transformContext())
         res = self.parameterAsDouble(parameters, self.RESOLUTION, context)
         if res < 0:
             raise QgsProcessingException(tr("RESOLUTION: expected a positive number of metres or 0"))
