@@ -195,3 +195,15 @@ def test_model_runs_whole_chain(block, tmp_path):
             da, db = a.read(masked=True), b.read(masked=True)
             assert np.array_equal(da.mask, db.mask), name
             assert np.allclose(da.filled(0), db.filled(0), atol=1e-4), name
+
+
+def test_model_bad_input(tmp_path):
+    """A missing image folder stops the model at its first step with a message naming IMAGES."""
+    out = {name: tmp_path / fname for name, fname in OUTPUTS.items()}
+    proc = _run_qgis_process(
+        "run", MODEL_ID, "--", f"IMAGES={tmp_path / 'nowhere'}", "CRS=EPSG:32632",
+        *(f"{name}={path}" for name, path in out.items()),
+    )  # fmt: skip
+    assert proc.returncode != 0
+    assert "IMAGES" in proc.stdout + proc.stderr
+    assert not any(p.exists() for p in out.values())
