@@ -460,13 +460,14 @@ def _interpolate(coarse: np.ndarray, window) -> np.ndarray:
 def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig) -> np.ndarray:
     """Colour of the best visible image per cell (uint8 RGB, 0 where none).
 
-    Per tile, all candidate images are sampled at the matched surface; an image
-    counts as seeing the cell when its luminance is within 0.1 of the median of
-    all views there (an occluded view sees something else), and among those the
-    one whose ray is closest to the system's Z axis gives the colour.
+    Per tile, every image that sees it is sampled at the matched surface; an
+    image counts as seeing a cell when its luminance is within 0.1 of the median
+    of all views there (an occluded view sees something else), and among those
+    the one whose ray from the cell is closest to the system's Z axis gives the
+    colour (decided per cell, so the choice does not jump at tile borders).
     """
     params = cfg.tile_params()
-    params.max_images = max(params.max_images, 16)
+    params.max_images = len(views)  # every image that sees the tile, on both sides of a tile border
     out = np.zeros(grid.shape + (3,), np.uint8)
     for tile in grid.tiles(int(cfg.tile_size), 0):
         r0, c0, nr, nc = tile.outer
@@ -480,8 +481,7 @@ def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig) -> np
         if not imgs:
             continue
         col = sample_surface(imgs, tx0, ty0, grid.res, zt)  # (n, rows, cols, 3)
-        scale = np.array([np.nanmax(im.window) if np.isfinite(im.window).any() else 1.0 for im in imgs])
-        scale = np.where(scale > 255.0, 65535.0, 255.0)
+        scale = np.array([pyr.value_max(im.view.index) for im in imgs])
         lum = (col[..., 0] * 0.299 + col[..., 1] * 0.587 + col[..., 2] * 0.114) / scale[:, None, None]
         import warnings
 
@@ -489,14 +489,24 @@ def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig) -> np
             warnings.simplefilter("ignore", RuntimeWarning)
             med = np.nanmedian(lum, axis=0)
         agree = np.abs(lum - med[None]) <= 0.1
-        angle = np.array([im.angle for im in imgs])[:, None, None]
-        score = np.where(agree, angle, np.inf)
+        X = tx0 + (np.arange(nc) + 0.5) * grid.res
+        Y = ty0 - (np.arange(nr) + 0.5) * grid.res
+        cos_ray = np.stack([_cos_to_axis(im.view.C, X, Y, zt) for im in imgs])
+        score = np.where(agree, -cos_ray, np.inf)
         best = np.argmin(score, axis=0)
         has = np.isfinite(np.take_along_axis(score, best[None], 0)[0]) & ok
         c = np.take_along_axis(col, best[None, :, :, None], 0)[0] / scale[best][..., None] * 255.0
         tile_rgb = np.where(has[..., None], np.clip(np.nan_to_num(c) + 0.5, 1, 255), 0).astype(np.uint8)
         out[r0 : r0 + nr, c0 : c0 + nc] = tile_rgb
     return out
+
+
+def _cos_to_axis(C, X, Y, z) -> np.ndarray:
+    """Cosine between the ray from every cell (X[col], Y[row], z) to ``C`` and the system's Z axis."""
+    dx = C[0] - X[None, :]
+    dy = C[1] - Y[:, None]
+    dz = C[2] - z
+    return dz / np.sqrt(dx * dx + dy * dy + dz * dz)
 
 
 # ------------------------------------------------------------------ the entry point

@@ -158,6 +158,7 @@ class ImagePyramid:
         self._bytes = 0
         self.reads = 0
         self._windowed = [_use_rasterio(p) for p in self.paths]
+        self._value_max: dict[int, float] = {}
 
     # ------------------------------------------------------------ cache
     def _put(self, key, value) -> None:
@@ -207,6 +208,13 @@ class ImagePyramid:
             b = img if img.ndim == 2 else img[:, :, self.band]
             return np.ascontiguousarray(b.astype(np.float32))
         return luminance(img)
+
+    def value_max(self, i: int) -> float:
+        """Full-scale value of image ``i`` (255 for 8-bit, 65535 for 16-bit, 1 for float data)."""
+        if i not in self._value_max:
+            dt = np.dtype(image_info(self.paths[i]).dtype)
+            self._value_max[i] = float(np.iinfo(dt).max) if dt.kind in "ui" else 1.0
+        return self._value_max[i]
 
     def level_size(self, i: int, level: int) -> tuple[int, int]:
         w, h = self.sizes[i]
