@@ -80,6 +80,33 @@ def _lattice(x0, y0, res, rows, cols, n=9):
     return X.ravel(), Y.ravel()
 
 
+#: Views per tile point the image choice aims at before it prefers the most nadir image.
+TARGET_VIEWS = 4
+
+
+def _select(cand, max_images: int):
+    """Greedy choice of at most ``max_images`` images for a tile.
+
+    Every tile lattice point should be seen by :data:`TARGET_VIEWS` images: each step
+    takes the image that adds most views where points still lack them (ties: the smaller
+    viewing angle), so the corners of a tile are not left to one image when the most
+    nadir images all cover its centre; once every point has its views, the most nadir
+    remaining images follow.
+    """
+    if len(cand) <= max_images:
+        return [(a, d, v) for _, a, d, v in sorted(cand, key=lambda t: t[1])]
+    count = np.zeros(len(cand[0][0]), np.int64)
+    left = list(range(len(cand)))
+    chosen = []
+    while left and len(chosen) < max_images:
+        need = np.maximum(TARGET_VIEWS - count, 0)
+        best = max(left, key=lambda k: (int(need[cand[k][0]].sum()), -cand[k][1]))
+        chosen.append(best)
+        left.remove(best)
+        count += cand[best][0]
+    return [(cand[k][1], cand[k][2], cand[k][3]) for k in chosen]
+
+
 def choose_images(
     views, pyr: ImagePyramid, x0, y0, res, rows, cols, z_lo, z_hi, params: TileParams, colour: bool = False
 ) -> list[TileImage]:
@@ -98,14 +125,11 @@ def choose_images(
         w, h = v.camera.width, v.camera.height
         inside = (uv_mid[:, 0] >= -0.5) & (uv_mid[:, 0] <= w - 0.5) & (uv_mid[:, 1] >= -0.5)
         inside &= uv_mid[:, 1] <= h - 0.5
-        cover = float(inside.mean())
-        if cover < 0.02:
+        if inside.mean() < 0.02:
             continue
-        cand.append((cover, angle, dist, v))
-    # coverage first (in steps of a tenth, so near-equal coverage falls back to the angle)
-    cand.sort(key=lambda t: (-round(t[0] * 10), t[1]))
+        cand.append((inside, angle, dist, v))
     out = []
-    for _cover, angle, dist, v in cand[: params.max_images]:
+    for angle, dist, v in _select(cand, params.max_images):
         depth = dist * max(v.axis_cos, 0.2)
         gsd = depth / v.camera.fx
         level = max(0, int(math.floor(math.log2(max(res / gsd, 1.0)) + 1e-6)))
