@@ -265,6 +265,52 @@ def _auto_k(nv):
 
 
 @njit
+def _smallest_sum(buf, m, k):
+    """Sum of the ``k`` smallest of ``buf[:m]`` (``1 <= k <= m``), by quickselect (reorders ``buf``).
+
+    Linear on average, where the insertion sort it replaces was quadratic in the
+    number of pairs (66 for 12 views).
+    """
+    lo = 0
+    hi = m - 1
+    while lo < hi:
+        mid = (lo + hi) // 2
+        # median of three as the pivot
+        a, b, c = buf[lo], buf[mid], buf[hi]
+        if a > b:
+            a, b = b, a
+        if b > c:
+            b = c
+            if a > b:
+                b = a
+        pivot = b
+        i = lo
+        j = hi
+        while i <= j:
+            while buf[i] < pivot:
+                i += 1
+            while buf[j] > pivot:
+                j -= 1
+            if i <= j:
+                t = buf[i]
+                buf[i] = buf[j]
+                buf[j] = t
+                i += 1
+                j -= 1
+        # buf[lo..j] <= pivot <= buf[i..hi]
+        if k - 1 <= j:
+            hi = j
+        elif k - 1 >= i:
+            lo = i
+        else:
+            break
+    s = 0.0
+    for q in range(k):
+        s += buf[q]
+    return s
+
+
+@njit
 def _combine(pc, npairs, nv, best_k, buf):
     """Mean of the ``k`` smallest valid pair contributions ``pc[:npairs]`` (NaN skipped).
 
@@ -274,22 +320,19 @@ def _combine(pc, npairs, nv, best_k, buf):
     for p in range(npairs):
         v = pc[p]
         if v == v:
-            # insertion into the sorted prefix buf[:m]
-            j = m
-            while j > 0 and buf[j - 1] > v:
-                buf[j] = buf[j - 1]
-                j -= 1
-            buf[j] = v
+            buf[m] = v
             m += 1
     if m == 0:
         return -1.0
     k = best_k if best_k > 0 else _auto_k(nv)
     if k > m:
         k = m
-    s = 0.0
-    for j in range(k):
-        s += buf[j]
-    return s / k
+    if k == m:
+        s = 0.0
+        for j in range(m):
+            s += buf[j]
+        return s / k
+    return _smallest_sum(buf, m, k) / k
 
 
 @pjit
