@@ -493,7 +493,7 @@ def _match_system(
     executor = executor or InProcessExecutor()
     params = cfg.tile_params()
     views = _system_views(o, system)
-    ctx = TileContext(pyr.paths, tuple(pyr.sizes), pyr.band, pyr.max_bytes, views, pyramid=pyr)
+    ctx = TileContext(tuple(pyr.paths), tuple(pyr.sizes), pyr.band, pyr.max_bytes, views, pyramid=pyr)
     base = ""
     if cache is not None:
         base = Digest(cache_base, ctx.digest().hexdigest(), np.asarray(system.Q, np.float64)).hexdigest()

@@ -58,7 +58,7 @@ class TileContext:
         return state
 
     def pyramid_key(self) -> tuple:
-        return (self.paths, self.sizes, self.band, int(self.cache_bytes))
+        return (tuple(self.paths), tuple(tuple(s) for s in self.sizes), self.band, int(self.cache_bytes))
 
     def digest(self) -> Digest:
         """Identity of the inputs: image files (path, size, mtime), views, band."""

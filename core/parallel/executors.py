@@ -252,6 +252,22 @@ class _DaskBase(_Base):
                 shared_f.release()
 
 
+def _spawn_python() -> None:
+    """Inside QGIS ``sys.executable`` may be the QGIS binary: spawn workers with a Python."""
+    import shutil
+    import sys
+
+    if "python" in os.path.basename(sys.executable or "").lower():
+        return
+    from distributed.utils import get_mp_context
+
+    candidates = [os.path.join(sys.exec_prefix, "bin", "python3"), shutil.which("python3") or ""]
+    for exe in candidates:
+        if exe and os.access(exe, os.X_OK):
+            get_mp_context().set_executable(exe)  # type: ignore[attr-defined]
+            return
+
+
 def _worker_memory_default(n_workers: int) -> int:
     import psutil
 
@@ -292,6 +308,7 @@ class LocalDaskExecutor(_DaskBase):
         if self.client is None:
             from distributed import Client, LocalCluster
 
+            _spawn_python()
             self.cluster = LocalCluster(
                 n_workers=self.n_workers,
                 threads_per_worker=1,
