@@ -564,137 +564,162 @@
             <translation>IMAGES: {} ist kein Ordner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="38" />
+            <location filename="../processing/algorithms/osgm.py" line="39" />
             <source>Dense matching (OSGM)</source>
             <translation>Dichte Bildzuordnung (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="273" />
+            <location filename="../processing/algorithms/osgm.py" line="308" />
             <source>DSM (OSGM)</source>
             <translation>DOM (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="70" />
+            <location filename="../processing/algorithms/osgm.py" line="74" />
             <source>Extent (default: the area seen by the images)</source>
             <translation>Ausdehnung (Standard: der von den Bildern gesehene Bereich)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="76" />
+            <location filename="../processing/algorithms/osgm.py" line="80" />
             <source>Resolution (m; empty or 0 = median ground sample distance)</source>
             <translation>Auflösung (m; leer oder 0 = mittlere Bodenpixelgröße)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="86" />
+            <location filename="../processing/algorithms/osgm.py" line="90" />
             <source>Height step of the search (m; empty or 0 = the resolution)</source>
             <translation>Höhenschritt der Suche (m; leer oder 0 = die Auflösung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="96" />
+            <location filename="../processing/algorithms/osgm.py" line="100" />
             <source>Lowest height searched (m; empty = automatic)</source>
             <translation>Niedrigste gesuchte Höhe (m; leer = automatisch)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="105" />
+            <location filename="../processing/algorithms/osgm.py" line="109" />
             <source>Highest height searched (m; empty = automatic)</source>
             <translation>Höchste gesuchte Höhe (m; leer = automatisch)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="113" />
+            <location filename="../processing/algorithms/osgm.py" line="117" />
             <source>Coarse surface bounding the search per cell (DSM/DTM)</source>
             <translation>Grobe Oberfläche, die die Suche je Zelle begrenzt (DOM/DGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="119" />
+            <location filename="../processing/algorithms/osgm.py" line="123" />
             <source>Aggregation paths</source>
             <translation>Aggregationspfade</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="127" />
+            <location filename="../processing/algorithms/osgm.py" line="131" />
             <source>Oblique images</source>
             <translation>Schrägbilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="135" />
+            <location filename="../processing/algorithms/osgm.py" line="139" />
             <source>Penalty P1, one height step (cost units; empty = default)</source>
             <translation>Strafterm P1, ein Höhenschritt (Kosteneinheiten; leer = Standard)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="146" />
+            <location filename="../processing/algorithms/osgm.py" line="150" />
             <source>Penalty P2, larger height jumps (cost units; empty = default)</source>
             <translation>Strafterm P2, größere Höhensprünge (Kosteneinheiten; leer = Standard)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="155" />
+            <location filename="../processing/algorithms/osgm.py" line="159" />
             <source>Images per tile (at most)</source>
             <translation>Bilder pro Kachel (höchstens)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="159" />
+            <location filename="../processing/algorithms/osgm.py" line="163" />
             <source>Tile size (cells)</source>
             <translation>Kachelgröße (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="165" />
+            <location filename="../processing/algorithms/osgm.py" line="169" />
+            <source>Run tiles on</source>
+            <translation>Kacheln ausführen auf</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="184" />
+            <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
+            <translation>Adresse des Dask-Schedulers (tls://host:port oder Scheduler-Datei; leer = TRUORTHO_DASK_SCHEDULER)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="196" />
             <source>Confidence [0, 1]</source>
             <translation>Konfidenz [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="170" />
+            <location filename="../processing/algorithms/osgm.py" line="201" />
             <source>Orthoimage (matching colours)</source>
             <translation>Orthobild (Farben der Zuordnung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="176" />
+            <location filename="../processing/algorithms/osgm.py" line="207" />
             <source>Point cloud</source>
             <translation>Punktwolke</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="201" />
+            <location filename="../processing/algorithms/osgm.py" line="232" />
             <source>EXTENT: the extent is empty</source>
             <translation>EXTENT: die Ausdehnung ist leer</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="276" />
+            <location filename="../processing/algorithms/osgm.py" line="311" />
             <source>Confidence (OSGM)</source>
             <translation>Konfidenz (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="279" />
+            <location filename="../processing/algorithms/osgm.py" line="314" />
             <source>Orthoimage (OSGM)</source>
             <translation>Orthobild (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="128" />
+            <location filename="../processing/algorithms/osgm.py" line="132" />
             <source>none: one nadir reference system</source>
             <translation>none: ein Nadir-Referenzsystem</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="128" />
+            <location filename="../processing/algorithms/osgm.py" line="132" />
             <source>auto: extra systems for obliques</source>
             <translation>auto: zusätzliche Systeme für Schrägbilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="214" />
+            <location filename="../processing/algorithms/osgm.py" line="171" />
+            <source>inprocess: this process (all cores)</source>
+            <translation>inprocess: dieser Prozess (alle Kerne)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="172" />
+            <source>local: a Dask cluster of worker processes on this computer</source>
+            <translation>local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="173" />
+            <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
+            <translation>scheduler: ein Dask-Scheduler (SCHEDULER_ADDRESS)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="245" />
             <source>ORIENTATION: the file {!r} does not exist</source>
             <translation>ORIENTATION: die Datei {!r} existiert nicht</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="226" />
+            <location filename="../processing/algorithms/osgm.py" line="257" />
             <source>Z_MIN ({}) must be below Z_MAX ({})</source>
             <translation>Z_MIN ({}) muss unter Z_MAX ({}) liegen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="242" />
+            <location filename="../processing/algorithms/osgm.py" line="273" />
             <source>POINT_CLOUD: expected a .las or .laz file, got {!r}</source>
             <translation>POINT_CLOUD: .las- oder .laz-Datei erwartet, erhalten: {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="221" />
+            <location filename="../processing/algorithms/osgm.py" line="252" />
             <source>{}: must be positive (or empty), got {}</source>
             <translation>{}: muss positiv (oder leer) sein, erhalten: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="232" />
+            <location filename="../processing/algorithms/osgm.py" line="263" />
             <source>Z_SURFACE: expected a raster file (GeoTIFF), got {!r}</source>
             <translation>Z_SURFACE: Rasterdatei (GeoTIFF) erwartet, erhalten: {!r}</translation>
         </message>
@@ -1255,346 +1280,356 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="192" />
+            <source>Where the tiles are matched; the DSM and confidence are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with the same inputs and parameters after a crash reuses them.</source>
+            <translation>Wo die Kacheln zugeordnet werden; DOM und Konfidenz sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Fertige Kacheln werden bis zum Ende des Laufs neben dem DOM aufbewahrt (DSM.tif.tiles), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="200" />
+            <source>Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. Security: a Dask scheduler executes any code its clients send, so it must never be reachable unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address that is not on this computer is refused.</source>
+            <translation>Adresse des Dask-Schedulers für EXECUTOR = scheduler: tls://host:8786 oder der Pfad einer Scheduler-Datei; leer = die Umgebungsvariable TRUORTHO_DASK_SCHEDULER. Sicherheit: Ein Dask-Scheduler führt jeden Code aus, den seine Clients senden, und darf daher nie ohne Authentifizierung erreichbar sein. Für einen entfernten Scheduler TLS mit Zertifikaten verwenden (in der Dask-Konfiguration, distributed.comm.tls) oder einen SSH-Tunnel nach 127.0.0.1; eine einfache tcp://-Adresse, die nicht auf diesem Rechner liegt, wird abgelehnt.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="206" />
             <source>The raw DSM: GeoTIFF, float32, in the orientation's CRS, nodata -9999.</source>
             <translation>Das rohe DOM: GeoTIFF, float32, im KBS der Orientierung, NoData -9999.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="193" />
+            <location filename="../processing/help/__init__.py" line="207" />
             <source>Optional confidence GeoTIFF (float32 in [0, 1], nodata -1) on the DSM grid, for truortho:dsmfilter.</source>
             <translation>Optionales Konfidenz-GeoTIFF (float32 in [0, 1], NoData -1) auf dem DOM-Raster, für truortho:dsmfilter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="195" />
+            <location filename="../processing/help/__init__.py" line="209" />
             <source>Optional RGB orthoimage GeoTIFF (uint8, 0 = no data) on the DSM grid, coloured from the matched images; not a true orthophoto (use truortho:trueortho for that).</source>
             <translation>Optionales RGB-Orthobild als GeoTIFF (uint8, 0 = keine Daten) auf dem DOM-Raster, aus den zugeordneten Bildern eingefärbt; kein True Orthophoto (dafür truortho:trueortho verwenden).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="197" />
+            <location filename="../processing/help/__init__.py" line="211" />
             <source>Optional point cloud (.laz or .las; LAS 1.4 with colours, 'confidence' and 'system', the reference system of each point).</source>
             <translation>Optionale Punktwolke (.laz oder .las; LAS 1.4 mit Farben, 'confidence' und 'system', dem Referenzsystem jedes Punktes).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="199" />
+            <location filename="../processing/help/__init__.py" line="213" />
             <source>JSON: grid size, resolution, height step and range (and where it came from), pyramid levels, tiles, completeness, mean confidence, reference systems, time.</source>
             <translation>JSON: Rastergröße, Auflösung, Höhenschritt und -bereich (und woher er stammt), Pyramidenstufen, Kacheln, Vollständigkeit, mittlere Konfidenz, Referenzsysteme, Zeit.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="205" />
+            <location filename="../processing/help/__init__.py" line="219" />
             <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
             <translation>Berechnet ein True Orthophoto aus orientierten Bildern und einer Oberfläche (einem DOM-Raster wie dem von OSGM oder einem PLY/OBJ-Dreiecksnetz): jede Zelle wird aus einem Bild eingefärbt, das sie wirklich sieht, ermittelt mit einem Tiefenpuffer der Oberfläche je Bild (DOM-Zellen als flache Dächer mit senkrechten Wänden an Höhensprüngen, oder die Dreiecke des Netzes; Frustum- und Rückseiten-Culling). Unter den Bildern, die eine Zelle sehen, wird dasjenige mit der feinsten effektiven Bodenauflösung (Entfernung und Einfallswinkel auf der Oberfläche) bevorzugt; Dächer werden jeweils aus einem einzigen Bild texturiert, und die Nahtlinien folgen Höhensprüngen und meiden Stellen, an denen die Bilder nicht übereinstimmen (Label-Glättung), mit Überblendung über die Nähte nur zwischen Bildern, die beide die Zellen sehen. Farbkorrekturen je Bild in CIE L*a*b* (Verstärkung/Versatz je Kanal für Nicht-RGB-Daten) werden per Ausgleichung nach kleinsten Quadraten aus Zellen geschätzt, die mehrere Bilder sehen. Zellen, die kein Bild sieht, erhalten Alpha 0 und erscheinen in der Verdeckungsmaske. Kanalanzahl und Datentyp der Bilder bleiben erhalten (RGB, 16-Bit-panchromatisch, thermal). Die Verarbeitung läuft kachelweise mit begrenztem Speicher; Fortschritt und Abbruch je Kachel.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="219" />
+            <location filename="../processing/help/__init__.py" line="233" />
             <source>Orientation JSON (from Orient images or Import orientation); its images must be on disk.</source>
             <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren); seine Bilder müssen auf der Festplatte vorhanden sein.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="221" />
+            <location filename="../processing/help/__init__.py" line="235" />
             <source>DSM GeoTIFF (any CRS; resampled onto the output grid by nearest neighbour) or a PLY/OBJ mesh. Heights must use the orientation's vertical datum. It must cover the extent.</source>
             <translation>DOM-GeoTIFF (beliebiges KBS; per nächstem Nachbarn auf das Ausgaberaster umgebildet) oder ein PLY/OBJ-Dreiecksnetz. Die Höhen müssen das Höhendatum der Orientierung verwenden. Es muss die Ausdehnung abdecken.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="223" />
+            <location filename="../processing/help/__init__.py" line="237" />
             <source>Output extent; default the surface's extent.</source>
             <translation>Ausgabeausdehnung; Standard ist die Ausdehnung der Oberfläche.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="224" />
+            <location filename="../processing/help/__init__.py" line="238" />
             <source>Output cell size in units of the output CRS; 0 = the DSM's cell size.</source>
             <translation>Ausgabezellgröße in Einheiten des Ausgabe-KBS; 0 = Zellgröße des DOM.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="225" />
+            <location filename="../processing/help/__init__.py" line="239" />
             <source>Output CRS; default the orientation's. When it differs, the computation runs on the output grid and cell centres are transformed to the orientation's CRS (images are resampled once).</source>
             <translation>Ausgabe-KBS; Standard ist das der Orientierung. Weicht es ab, läuft die Berechnung auf dem Ausgaberaster, und die Zellmittelpunkte werden in das KBS der Orientierung transformiert (die Bilder werden nur einmal umgebildet).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="228" />
+            <location filename="../processing/help/__init__.py" line="242" />
             <source>Estimate and apply per-image colour corrections before mosaicking.</source>
             <translation>Farbkorrekturen je Bild vor der Mosaikbildung schätzen und anwenden.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="229" />
+            <location filename="../processing/help/__init__.py" line="243" />
             <source>Largest off-nadir angle of the viewing ray (degrees) for an image to texture a cell; also bounds how far outside a tile occluders are searched.</source>
             <translation>Größter Winkel des Sehstrahls zum Nadir (Grad), unter dem ein Bild eine Zelle texturieren darf; begrenzt auch, wie weit außerhalb einer Kachel nach verdeckenden Objekten gesucht wird.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="231" />
+            <location filename="../processing/help/__init__.py" line="245" />
             <source>Width of the feathering across seamlines, in cells (0 = hard seams).</source>
             <translation>Breite der Überblendung an den Nahtlinien, in Zellen (0 = harte Nähte).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="232" />
+            <location filename="../processing/help/__init__.py" line="246" />
             <source>Tile side in cells; memory grows with its square and the images per tile.</source>
             <translation>Kachelseite in Zellen; der Speicherbedarf wächst mit ihrem Quadrat und den Bildern pro Kachel.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="233" />
+            <location filename="../processing/help/__init__.py" line="247" />
             <source>GeoTIFF with the images' bands and data type plus an alpha band, tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
             <translation>GeoTIFF mit den Kanälen und dem Datentyp der Bilder plus einem Alphakanal, gekachelt, mit Übersichten, im Cloud-Optimized-GeoTIFF-Layout.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="235" />
+            <location filename="../processing/help/__init__.py" line="249" />
             <source>Int16 GeoTIFF: index (0-based, orientation order) of the image each cell comes from; -1 = nodata.</source>
             <translation>Int16-GeoTIFF: Index (ab 0, Reihenfolge der Orientierung) des Bildes, aus dem jede Zelle stammt; -1 = NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="237" />
+            <location filename="../processing/help/__init__.py" line="251" />
             <source>UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the surface has no data.</source>
             <translation>UInt8-GeoTIFF: 1, wo kein Bild die Zelle sieht, 0, wo sie gesehen wird, 255, wo die Oberfläche keine Daten hat.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="239" />
+            <location filename="../processing/help/__init__.py" line="253" />
             <source>Polygons, one feature per source image: the cells it colours (image_index, image, cells, area).</source>
             <translation>Polygone, ein Objekt pro Quellbild: die Zellen, die es einfärbt (image_index, image, cells, area).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="245" />
+            <location filename="../processing/help/__init__.py" line="259" />
             <source>Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the cells of blurred height steps to the nearer side, removes outliers (cells that depart from the confidence-weighted median of their window by more than the threshold and have too few neighbours at their height, so roof edges and corners survive), fills holes up to a maximum width by harmonic interpolation (holes at the foot of walls from the ground side only; wider holes stay nodata and are reported), and optionally smooths planar surfaces without blurring their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the statistics (removed outliers, filled cells, remaining holes) are returned and logged.</source>
             <translation>Bereinigt ein rohes DOM (z. B. das DOM der dichten Bildzuordnung aus dem OSGM-Schritt von TruOrtho) kachelweise: schiebt die Zellen verschliffener Höhensprünge auf die nähere Seite, entfernt Ausreißer (Zellen, die um mehr als die Schwelle vom konfidenzgewichteten Median ihres Fensters abweichen und zu wenige Nachbarn auf ihrer Höhe haben, sodass Dachkanten und Ecken erhalten bleiben), füllt Lücken bis zu einer Höchstbreite durch harmonische Interpolation (Lücken am Fuß von Wänden nur von der Bodenseite aus; breitere Lücken bleiben NoData und werden gemeldet) und glättet optional ebene Flächen, ohne ihre Kanten zu verwischen. Optional wird ein Geländemodell (DGM) durch Bodenfilterung nach Art von SMRF abgeleitet sowie das normalisierte DOM (Höhe über Gelände). Die Ausgaben behalten KBS, Raster und NoData der Eingabe; die Statistik (entfernte Ausreißer, gefüllte Zellen, verbleibende Lücken) wird zurückgegeben und protokolliert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="256" />
+            <location filename="../processing/help/__init__.py" line="270" />
             <source>Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.</source>
             <translation>Rohes DOM: einkanaliges Raster mit einem projizierten KBS (Meter); seine NoData-Zellen sind Lücken.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="257" />
+            <location filename="../processing/help/__init__.py" line="271" />
             <source>Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum confidence are removed, less confident cells must agree better with their neighbours, and the median is weighted by confidence.</source>
             <translation>Optionales Konfidenzraster in [0, 1] (CONFIDENCE von OSGM): Zellen unter der Mindestkonfidenz werden entfernt, weniger zuverlässige Zellen müssen besser mit ihren Nachbarn übereinstimmen, und der Median wird mit der Konfidenz gewichtet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="260" />
+            <location filename="../processing/help/__init__.py" line="274" />
             <source>Largest departure from the neighbourhood median, metres (empty: 4 x the resolution).</source>
             <translation>Größte Abweichung vom Median der Nachbarschaft, Meter (leer: 4 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="262" />
+            <location filename="../processing/help/__init__.py" line="276" />
             <source>Side of the median window in cells (odd); a second pass uses twice the window.</source>
             <translation>Seitenlänge des Medianfensters in Zellen (ungerade); ein zweiter Durchlauf verwendet das doppelte Fenster.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="264" />
+            <location filename="../processing/help/__init__.py" line="278" />
             <source>Neighbours within the threshold of a cell's height that keep it although it departs from the median (edges, corners, thin structures).</source>
             <translation>Nachbarn innerhalb der Schwelle um die Höhe einer Zelle, die sie erhalten, obwohl sie vom Median abweicht (Kanten, Ecken, dünne Strukturen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="266" />
+            <location filename="../processing/help/__init__.py" line="280" />
             <source>With a confidence raster: cells below this confidence are removed.</source>
             <translation>Mit einem Konfidenzraster: Zellen unter dieser Konfidenz werden entfernt.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="267" />
+            <location filename="../processing/help/__init__.py" line="281" />
             <source>With a confidence raster: less confident cells are removed when they depart by more than the threshold from the median of the cells at least this confident in their 15 x 15 window (0: off).</source>
             <translation>Mit einem Konfidenzraster: weniger zuverlässige Zellen werden entfernt, wenn sie um mehr als die Schwelle vom Median der Zellen mit mindestens dieser Konfidenz in ihrem 15-x-15-Fenster abweichen (0: aus).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="270" />
+            <location filename="../processing/help/__init__.py" line="284" />
             <source>Largest hole width (metres) that is interpolated; 0 fills nothing.</source>
             <translation>Größte Lückenbreite (Meter), die interpoliert wird; 0 füllt nichts.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="271" />
+            <location filename="../processing/help/__init__.py" line="285" />
             <source>Height difference between two surfaces (a wall), metres: hole boundary cells that much above nearby boundary cells are not interpolated from.</source>
             <translation>Höhenunterschied zwischen zwei Oberflächen (eine Wand), Meter: Randzellen einer Lücke, die so viel höher als benachbarte Randzellen liegen, werden nicht zur Interpolation verwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="273" />
+            <location filename="../processing/help/__init__.py" line="287" />
             <source>Snap the cells of blurred height steps (between the two levels of their 5 x 5 window) to the nearer level.</source>
             <translation>Die Zellen verschliffener Höhensprünge (zwischen den beiden Niveaus ihres 5-x-5-Fensters) auf das nähere Niveau schieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="275" />
+            <location filename="../processing/help/__init__.py" line="289" />
             <source>Replace cells by a local plane fitted to the neighbours at their height (flat and pitched roofs, streets); steps stay sharp.</source>
             <translation>Zellen durch eine lokale Ebene ersetzen, die an die Nachbarn auf ihrer Höhe angepasst ist (Flach- und Schrägdächer, Straßen); Sprünge bleiben scharf.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="277" />
+            <location filename="../processing/help/__init__.py" line="291" />
             <source>Radius of the smoothing neighbourhood, cells.</source>
             <translation>Radius der Glättungsnachbarschaft, Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="278" />
+            <location filename="../processing/help/__init__.py" line="292" />
             <source>Neighbours within this height of a cell belong to its surface, metres (empty: 2.5 x the resolution).</source>
             <translation>Nachbarn innerhalb dieser Höhe um eine Zelle gehören zu ihrer Oberfläche, Meter (leer: 2,5 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="280" />
+            <location filename="../processing/help/__init__.py" line="294" />
             <source>Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); the DTM is written on the DSM grid.</source>
             <translation>Zellgröße des Bodenfilters, Meter (leer: max(1 m, DOM-Auflösung)); das DGM wird auf dem DOM-Raster geschrieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="282" />
+            <location filename="../processing/help/__init__.py" line="296" />
             <source>Largest opening radius of the ground filter, metres: more than half the width of the largest building.</source>
             <translation>Größter Öffnungsradius des Bodenfilters, Meter: mehr als die halbe Breite des größten Gebäudes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="284" />
+            <location filename="../processing/help/__init__.py" line="298" />
             <source>Terrain slope (rise over run) the ground filter keeps as ground.</source>
             <translation>Geländeneigung (Höhe pro Strecke), die der Bodenfilter als Boden behält.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="285" />
+            <location filename="../processing/help/__init__.py" line="299" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>Gefiltertes DOM (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="286" />
+            <location filename="../processing/help/__init__.py" line="300" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Optionales Geländemodell (GeoTIFF, float32, DOM-Raster).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="287" />
+            <location filename="../processing/help/__init__.py" line="301" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>Optionales normalisiertes DOM: DOM minus DGM, Höhen über dem Gelände.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="288" />
+            <location filename="../processing/help/__init__.py" line="302" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON: die Filterstatistik (und die des Bodenfilters).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="289" />
+            <location filename="../processing/help/__init__.py" line="303" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Als Ausreißer oder wegen geringer Konfidenz entfernte Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="290" />
+            <location filename="../processing/help/__init__.py" line="304" />
             <source>Hole cells interpolated.</source>
             <translation>Interpolierte Lückenzellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="291" />
+            <location filename="../processing/help/__init__.py" line="305" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Lücken, breiter als MAX_HOLE, als NoData belassen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="296" />
+            <location filename="../processing/help/__init__.py" line="310" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Erzeugt eine Dreiecksvermaschung. Aus einem DOM: ein 2,5D-Netz, dessen Höhensprünge senkrechte Wände sind (kein Dreieck überspannt je einen Sprung) und dessen ebene und glatte Bereiche durch einen eingeschränkten Quadtree mit garantierter Höhenfehlerschranke an jedem Zellmittelpunkt ausgedünnt werden; Eckpunktfarben aus einem optionalen Orthobild. Aus einer Punktwolke (LAS/LAZ oder EPT, z. B. zusammengeführte Zuordnung von Schrägbildern): ein 2,5D-Delaunay-Netz je Referenzsystem, entlang seiner Blickrichtung gesehen (überlappende Schichten, wo Systeme dieselbe Oberfläche sehen; nicht wasserdicht). Schreibt PLY (binär) oder OBJ, im KBS oder in einem lokalen System, dessen Offset im Dateikopf vermerkt ist; truortho:trueortho liest es als SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="305" />
+            <location filename="../processing/help/__init__.py" line="319" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>DOM-Raster (projiziertes KBS) oder Punktwolke (.las, .laz oder eine EPT-ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="306" />
+            <location filename="../processing/help/__init__.py" line="320" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Optionales Orthobild (RGB) für die Eckpunktfarben eines DOM-Netzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="307" />
+            <location filename="../processing/help/__init__.py" line="321" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Größter Höhenunterschied zwischen Netz und DOM an einem Zellmittelpunkt, Meter (leer: halbe DOM-Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="309" />
+            <location filename="../processing/help/__init__.py" line="323" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Kleinster Höhenunterschied zwischen benachbarten Zellen, der zur Wand wird, Meter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="310" />
+            <location filename="../processing/help/__init__.py" line="324" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Steilste als geneigte Dreiecke erhaltene Neigung, Grad: die Sprungschwelle ist max(MIN_STEP, Auflösung x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="312" />
+            <location filename="../processing/help/__init__.py" line="326" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Größter Zellblock, den ein Dreieckspaar abdecken darf (eine Zweierpotenz).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="313" />
+            <location filename="../processing/help/__init__.py" line="327" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Punktwolken: längste Dreieckskante, Meter (leer: 4 x der mittlere Punktabstand).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="314" />
+            <location filename="../processing/help/__init__.py" line="328" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>CRS: Weltkoordinaten (PLY-Doubles). Lokal: Welt minus einem Offset, vermerkt als 'comment offset E N H' (PLY) oder '# offset E N H' (OBJ), für Viewer, die kleine Zahlen benötigen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="316" />
+            <location filename="../processing/help/__init__.py" line="330" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Das Netz: .ply (binär, Little-Endian, 'comment crs ...') oder .obj ('# crs ...', Eckpunktfarben als 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="318" />
+            <location filename="../processing/help/__init__.py" line="332" />
             <source>Number of vertices.</source>
             <translation>Anzahl der Eckpunkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="319" />
+            <location filename="../processing/help/__init__.py" line="333" />
             <source>Number of triangles.</source>
             <translation>Anzahl der Dreiecke.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="320" />
+            <location filename="../processing/help/__init__.py" line="334" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Anzahl der senkrechten Wanddreiecke (DOM-Netze).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="325" />
+            <location filename="../processing/help/__init__.py" line="339" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (Layer &gt; Add Layer &gt; Point Cloud, choose ept.json).</source>
             <translation>Exportiert ein DOM als Punktwolke, ein Punkt je gültigem Zellmittelpunkt, mit Farben aus einem Orthobild und Konfidenz je Punkt aus einem Konfidenzraster: LAS 1.4 oder LAZ (Punktformat 7, KBS als WKT, Zusatzdimensionen 'confidence' und 'system' (das Referenzsystem), ein TruOrtho-VLR, der die Referenzsysteme beschreibt), lesbar mit PDAL, laspy, LAStools und CloudCompare. Daneben wird ein Entwine-Point-Tile-Datensatz (EPT) geschrieben: QGIS-Builds ohne PDAL (wie das QGIS 3.22 von Debian) öffnen ihn als Punktwolken-Layer (Layer &gt; Layer hinzufügen &gt; Punktwolke, ept.json wählen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="333" />
+            <location filename="../processing/help/__init__.py" line="347" />
             <source>DSM raster with a projected CRS.</source>
             <translation>DOM-Raster mit einem projizierten KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="334" />
+            <location filename="../processing/help/__init__.py" line="348" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Optionales Orthobild (RGB) für die Punktfarben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="335" />
+            <location filename="../processing/help/__init__.py" line="349" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Optionales Konfidenzraster in [0, 1], gespeichert als Dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="336" />
+            <location filename="../processing/help/__init__.py" line="350" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Die Punktwolke (.laz komprimiert oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="337" />
+            <location filename="../processing/help/__init__.py" line="351" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Ordner des EPT-Datensatzes (ept.json, ept-data/, ept-hierarchy/); leer lassen, um ihn zu überspringen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="338" />
+            <location filename="../processing/help/__init__.py" line="352" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Pfad der ept.json des EPT-Datensatzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="339" />
+            <location filename="../processing/help/__init__.py" line="353" />
             <source>Number of points written.</source>
             <translation>Anzahl der geschriebenen Punkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="344" />
+            <location filename="../processing/help/__init__.py" line="358" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Führt Punktwolken mehrerer Referenzsysteme (z. B. das Nadir- und die Schrägsysteme der dichten Bildzuordnung) in einer LAS-1.4-/LAZ-Datei zusammen und behält dabei 'system' jedes Punktes (Dateien ohne dieses Attribut erhalten den Index ihrer Datei) und seine Konfidenz; dünnt optional Duplikate auf einem Voxelgitter aus und behält den zuverlässigsten Punkt jedes Voxels; schreibt optional einen EPT-Datensatz für QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="350" />
+            <location filename="../processing/help/__init__.py" line="364" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>LAS/LAZ-Dateien in einem KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="351" />
+            <location filename="../processing/help/__init__.py" line="365" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Voxelgröße für das Ausdünnen, Meter (leer: jeden Punkt behalten).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="352" />
+            <location filename="../processing/help/__init__.py" line="366" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Die zusammengeführte Punktwolke (.laz oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="353" />
+            <location filename="../processing/help/__init__.py" line="367" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Optionaler Ordner für einen EPT-Datensatz der zusammengeführten Wolke.</translation>
         </message>

@@ -564,137 +564,162 @@
             <translation>IMAGES : {} n'est pas un dossier</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="38" />
+            <location filename="../processing/algorithms/osgm.py" line="39" />
             <source>Dense matching (OSGM)</source>
             <translation>Appariement dense (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="273" />
+            <location filename="../processing/algorithms/osgm.py" line="308" />
             <source>DSM (OSGM)</source>
             <translation>MNS (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="70" />
+            <location filename="../processing/algorithms/osgm.py" line="74" />
             <source>Extent (default: the area seen by the images)</source>
             <translation>Emprise (par défaut : la zone vue par les images)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="76" />
+            <location filename="../processing/algorithms/osgm.py" line="80" />
             <source>Resolution (m; empty or 0 = median ground sample distance)</source>
             <translation>Résolution (m ; vide ou 0 = taille médiane du pixel au sol)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="86" />
+            <location filename="../processing/algorithms/osgm.py" line="90" />
             <source>Height step of the search (m; empty or 0 = the resolution)</source>
             <translation>Pas de hauteur de la recherche (m ; vide ou 0 = la résolution)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="96" />
+            <location filename="../processing/algorithms/osgm.py" line="100" />
             <source>Lowest height searched (m; empty = automatic)</source>
             <translation>Hauteur minimale recherchée (m ; vide = automatique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="105" />
+            <location filename="../processing/algorithms/osgm.py" line="109" />
             <source>Highest height searched (m; empty = automatic)</source>
             <translation>Hauteur maximale recherchée (m ; vide = automatique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="113" />
+            <location filename="../processing/algorithms/osgm.py" line="117" />
             <source>Coarse surface bounding the search per cell (DSM/DTM)</source>
             <translation>Surface grossière bornant la recherche par cellule (MNS/MNT)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="119" />
+            <location filename="../processing/algorithms/osgm.py" line="123" />
             <source>Aggregation paths</source>
             <translation>Chemins d'agrégation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="127" />
+            <location filename="../processing/algorithms/osgm.py" line="131" />
             <source>Oblique images</source>
             <translation>Images obliques</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="135" />
+            <location filename="../processing/algorithms/osgm.py" line="139" />
             <source>Penalty P1, one height step (cost units; empty = default)</source>
             <translation>Pénalité P1, un pas de hauteur (unités de coût ; vide = par défaut)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="146" />
+            <location filename="../processing/algorithms/osgm.py" line="150" />
             <source>Penalty P2, larger height jumps (cost units; empty = default)</source>
             <translation>Pénalité P2, sauts de hauteur plus grands (unités de coût ; vide = par défaut)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="155" />
+            <location filename="../processing/algorithms/osgm.py" line="159" />
             <source>Images per tile (at most)</source>
             <translation>Images par tuile (au plus)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="159" />
+            <location filename="../processing/algorithms/osgm.py" line="163" />
             <source>Tile size (cells)</source>
             <translation>Taille des tuiles (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="165" />
+            <location filename="../processing/algorithms/osgm.py" line="169" />
+            <source>Run tiles on</source>
+            <translation>Exécuter les tuiles sur</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="184" />
+            <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
+            <translation>Adresse du planificateur Dask (tls://hôte:port ou fichier de planificateur ; vide = TRUORTHO_DASK_SCHEDULER)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="196" />
             <source>Confidence [0, 1]</source>
             <translation>Confiance [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="170" />
+            <location filename="../processing/algorithms/osgm.py" line="201" />
             <source>Orthoimage (matching colours)</source>
             <translation>Orthoimage (couleurs de l'appariement)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="176" />
+            <location filename="../processing/algorithms/osgm.py" line="207" />
             <source>Point cloud</source>
             <translation>Nuage de points</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="201" />
+            <location filename="../processing/algorithms/osgm.py" line="232" />
             <source>EXTENT: the extent is empty</source>
             <translation>EXTENT : l'emprise est vide</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="276" />
+            <location filename="../processing/algorithms/osgm.py" line="311" />
             <source>Confidence (OSGM)</source>
             <translation>Confiance (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="279" />
+            <location filename="../processing/algorithms/osgm.py" line="314" />
             <source>Orthoimage (OSGM)</source>
             <translation>Orthoimage (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="128" />
+            <location filename="../processing/algorithms/osgm.py" line="132" />
             <source>none: one nadir reference system</source>
             <translation>none : un seul système de référence au nadir</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="128" />
+            <location filename="../processing/algorithms/osgm.py" line="132" />
             <source>auto: extra systems for obliques</source>
             <translation>auto : systèmes supplémentaires pour les obliques</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="214" />
+            <location filename="../processing/algorithms/osgm.py" line="171" />
+            <source>inprocess: this process (all cores)</source>
+            <translation>inprocess : ce processus (tous les cœurs)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="172" />
+            <source>local: a Dask cluster of worker processes on this computer</source>
+            <translation>local : une grappe Dask de processus de travail sur cet ordinateur</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="173" />
+            <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
+            <translation>scheduler : un planificateur Dask (SCHEDULER_ADDRESS)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/osgm.py" line="245" />
             <source>ORIENTATION: the file {!r} does not exist</source>
             <translation>ORIENTATION : le fichier {!r} n'existe pas</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="226" />
+            <location filename="../processing/algorithms/osgm.py" line="257" />
             <source>Z_MIN ({}) must be below Z_MAX ({})</source>
             <translation>Z_MIN ({}) doit être inférieur à Z_MAX ({})</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="242" />
+            <location filename="../processing/algorithms/osgm.py" line="273" />
             <source>POINT_CLOUD: expected a .las or .laz file, got {!r}</source>
             <translation>POINT_CLOUD : fichier .las ou .laz attendu, reçu {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="221" />
+            <location filename="../processing/algorithms/osgm.py" line="252" />
             <source>{}: must be positive (or empty), got {}</source>
             <translation>{} : doit être positif (ou vide), reçu {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="232" />
+            <location filename="../processing/algorithms/osgm.py" line="263" />
             <source>Z_SURFACE: expected a raster file (GeoTIFF), got {!r}</source>
             <translation>Z_SURFACE : fichier raster (GeoTIFF) attendu, reçu {!r}</translation>
         </message>
@@ -1255,346 +1280,356 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="192" />
+            <source>Where the tiles are matched; the DSM and confidence are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with the same inputs and parameters after a crash reuses them.</source>
+            <translation>Où les tuiles sont appariées ; le MNS et la confiance sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, une tuile après l'autre sur tous les cœurs (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire les images aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. Les tuiles terminées sont gardées à côté du MNS (DSM.tif.tiles) jusqu'à la fin du traitement, de sorte qu'une nouvelle exécution avec les mêmes entrées et paramètres après un plantage les réutilise.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="200" />
+            <source>Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. Security: a Dask scheduler executes any code its clients send, so it must never be reachable unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address that is not on this computer is refused.</source>
+            <translation>Adresse du planificateur Dask pour EXECUTOR = scheduler : tls://hôte:8786, ou le chemin d'un fichier de planificateur ; vide = la variable d'environnement TRUORTHO_DASK_SCHEDULER. Sécurité : un planificateur Dask exécute tout code que ses clients lui envoient, il ne doit donc jamais être joignable sans authentification. Utilisez TLS avec des certificats pour un planificateur distant (configuré dans la configuration de Dask, distributed.comm.tls), ou un tunnel SSH vers 127.0.0.1 ; une adresse tcp:// simple qui n'est pas sur cet ordinateur est refusée.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="206" />
             <source>The raw DSM: GeoTIFF, float32, in the orientation's CRS, nodata -9999.</source>
             <translation>Le MNS brut : GeoTIFF, float32, dans le SCR de l'orientation, NoData -9999.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="193" />
+            <location filename="../processing/help/__init__.py" line="207" />
             <source>Optional confidence GeoTIFF (float32 in [0, 1], nodata -1) on the DSM grid, for truortho:dsmfilter.</source>
             <translation>GeoTIFF de confiance facultatif (float32 dans [0, 1], NoData -1) sur la grille du MNS, pour truortho:dsmfilter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="195" />
+            <location filename="../processing/help/__init__.py" line="209" />
             <source>Optional RGB orthoimage GeoTIFF (uint8, 0 = no data) on the DSM grid, coloured from the matched images; not a true orthophoto (use truortho:trueortho for that).</source>
             <translation>Orthoimage RVB facultative en GeoTIFF (uint8, 0 = pas de données) sur la grille du MNS, colorée à partir des images appariées ; ce n'est pas une orthophoto vraie (utiliser truortho:trueortho pour cela).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="197" />
+            <location filename="../processing/help/__init__.py" line="211" />
             <source>Optional point cloud (.laz or .las; LAS 1.4 with colours, 'confidence' and 'system', the reference system of each point).</source>
             <translation>Nuage de points facultatif (.laz ou .las ; LAS 1.4 avec couleurs, 'confidence' et 'system', le système de référence de chaque point).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="199" />
+            <location filename="../processing/help/__init__.py" line="213" />
             <source>JSON: grid size, resolution, height step and range (and where it came from), pyramid levels, tiles, completeness, mean confidence, reference systems, time.</source>
             <translation>JSON : taille de la grille, résolution, pas et plage de hauteur (et leur origine), niveaux de pyramide, tuiles, complétude, confiance moyenne, systèmes de référence, durée.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="205" />
+            <location filename="../processing/help/__init__.py" line="219" />
             <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
             <translation>Calcule une orthophoto vraie à partir d'images orientées et d'une surface (un raster MNS comme celui d'OSGM, ou un maillage PLY/OBJ) : chaque cellule est colorée à partir d'une image qui la voit réellement, déterminée avec un tampon de profondeur de la surface par image (cellules du MNS comme sommets plats avec murs verticaux aux sauts de hauteur, ou les triangles du maillage ; élimination hors du champ de vue et des faces arrière). Parmi les images qui voient une cellule, celle de résolution au sol effective la plus fine (distance et incidence sur la surface) est préférée ; les toits sont texturés chacun à partir d'une seule image et les lignes de raccord suivent les discontinuités de hauteur et évitent les endroits où les images divergent (lissage des étiquettes), avec un fondu à travers les raccords uniquement entre images qui voient toutes deux les cellules. Des corrections colorimétriques par image dans CIE L*a*b* (gain/décalage par bande pour les données non RVB) sont estimées par moindres carrés à partir des cellules vues par plusieurs images. Les cellules qu'aucune image ne voit reçoivent un alpha de 0 et apparaissent dans le masque d'occultation. Le nombre de bandes et le type de données des images sont conservés (RVB, panchromatique 16 bits, thermique). Le traitement se fait par tuiles avec une mémoire bornée ; progression et annulation par tuile.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="219" />
+            <location filename="../processing/help/__init__.py" line="233" />
             <source>Orientation JSON (from Orient images or Import orientation); its images must be on disk.</source>
             <translation>JSON d'orientation (issu de Orienter les images ou Importer une orientation) ; ses images doivent être présentes sur le disque.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="221" />
+            <location filename="../processing/help/__init__.py" line="235" />
             <source>DSM GeoTIFF (any CRS; resampled onto the output grid by nearest neighbour) or a PLY/OBJ mesh. Heights must use the orientation's vertical datum. It must cover the extent.</source>
             <translation>GeoTIFF MNS (SCR quelconque ; rééchantillonné sur la grille de sortie au plus proche voisin) ou un maillage PLY/OBJ. Les hauteurs doivent être dans le référentiel altimétrique de l'orientation. Il doit couvrir l'emprise.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="223" />
+            <location filename="../processing/help/__init__.py" line="237" />
             <source>Output extent; default the surface's extent.</source>
             <translation>Emprise de sortie ; par défaut l'emprise de la surface.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="224" />
+            <location filename="../processing/help/__init__.py" line="238" />
             <source>Output cell size in units of the output CRS; 0 = the DSM's cell size.</source>
             <translation>Taille de cellule de sortie dans les unités du SCR de sortie ; 0 = taille de cellule du MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="225" />
+            <location filename="../processing/help/__init__.py" line="239" />
             <source>Output CRS; default the orientation's. When it differs, the computation runs on the output grid and cell centres are transformed to the orientation's CRS (images are resampled once).</source>
             <translation>SCR de sortie ; par défaut celui de l'orientation. S'il diffère, le calcul se fait sur la grille de sortie et les centres des cellules sont transformés dans le SCR de l'orientation (les images ne sont rééchantillonnées qu'une fois).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="228" />
+            <location filename="../processing/help/__init__.py" line="242" />
             <source>Estimate and apply per-image colour corrections before mosaicking.</source>
             <translation>Estimer et appliquer des corrections colorimétriques par image avant le mosaïquage.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="229" />
+            <location filename="../processing/help/__init__.py" line="243" />
             <source>Largest off-nadir angle of the viewing ray (degrees) for an image to texture a cell; also bounds how far outside a tile occluders are searched.</source>
             <translation>Angle maximal du rayon de visée par rapport au nadir (degrés) pour qu'une image texture une cellule ; limite aussi jusqu'où, hors d'une tuile, les objets occultants sont recherchés.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="231" />
+            <location filename="../processing/help/__init__.py" line="245" />
             <source>Width of the feathering across seamlines, in cells (0 = hard seams).</source>
             <translation>Largeur du fondu aux lignes de raccord, en cellules (0 = raccords francs).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="232" />
+            <location filename="../processing/help/__init__.py" line="246" />
             <source>Tile side in cells; memory grows with its square and the images per tile.</source>
             <translation>Côté des tuiles en cellules ; la mémoire croît avec son carré et le nombre d'images par tuile.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="233" />
+            <location filename="../processing/help/__init__.py" line="247" />
             <source>GeoTIFF with the images' bands and data type plus an alpha band, tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
             <translation>GeoTIFF avec les bandes et le type de données des images plus une bande alpha, tuilé, avec aperçus, au format Cloud-Optimized GeoTIFF.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="235" />
+            <location filename="../processing/help/__init__.py" line="249" />
             <source>Int16 GeoTIFF: index (0-based, orientation order) of the image each cell comes from; -1 = nodata.</source>
             <translation>GeoTIFF Int16 : index (à partir de 0, dans l'ordre de l'orientation) de l'image dont provient chaque cellule ; -1 = NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="237" />
+            <location filename="../processing/help/__init__.py" line="251" />
             <source>UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the surface has no data.</source>
             <translation>GeoTIFF UInt8 : 1 là où aucune image ne voit la cellule, 0 là où elle est vue, 255 là où la surface n'a pas de données.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="239" />
+            <location filename="../processing/help/__init__.py" line="253" />
             <source>Polygons, one feature per source image: the cells it colours (image_index, image, cells, area).</source>
             <translation>Polygones, une entité par image source : les cellules qu'elle colore (image_index, image, cells, area).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="245" />
+            <location filename="../processing/help/__init__.py" line="259" />
             <source>Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the cells of blurred height steps to the nearer side, removes outliers (cells that depart from the confidence-weighted median of their window by more than the threshold and have too few neighbours at their height, so roof edges and corners survive), fills holes up to a maximum width by harmonic interpolation (holes at the foot of walls from the ground side only; wider holes stay nodata and are reported), and optionally smooths planar surfaces without blurring their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the statistics (removed outliers, filled cells, remaining holes) are returned and logged.</source>
             <translation>Nettoie un MNS brut (par ex. le MNS d'appariement dense de l'étape OSGM de TruOrtho) tuile par tuile : ramène les cellules des sauts de hauteur flous du côté le plus proche, supprime les valeurs aberrantes (cellules qui s'écartent de plus que le seuil de la médiane pondérée par la confiance de leur fenêtre et ont trop peu de voisins à leur hauteur, de sorte que les bords et les angles des toits sont préservés), comble les trous jusqu'à une largeur maximale par interpolation harmonique (trous au pied des murs uniquement depuis le côté du sol ; les trous plus larges restent en NoData et sont signalés), et lisse en option les surfaces planes sans en estomper les arêtes. Dérive en option un modèle numérique de terrain (MNT) par un filtrage du sol de type SMRF, ainsi que le MNS normalisé (hauteur au-dessus du terrain). Les sorties conservent le SCR, la grille et le NoData de l'entrée ; les statistiques (valeurs aberrantes supprimées, cellules comblées, trous restants) sont renvoyées et journalisées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="256" />
+            <location filename="../processing/help/__init__.py" line="270" />
             <source>Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.</source>
             <translation>MNS brut : raster à une bande dans un SCR projeté (mètres) ; ses cellules NoData sont des trous.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="257" />
+            <location filename="../processing/help/__init__.py" line="271" />
             <source>Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum confidence are removed, less confident cells must agree better with their neighbours, and the median is weighted by confidence.</source>
             <translation>Raster de confiance facultatif dans [0, 1] (CONFIDENCE d'OSGM) : les cellules sous la confiance minimale sont supprimées, les cellules moins fiables doivent mieux concorder avec leurs voisines, et la médiane est pondérée par la confiance.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="260" />
+            <location filename="../processing/help/__init__.py" line="274" />
             <source>Largest departure from the neighbourhood median, metres (empty: 4 x the resolution).</source>
             <translation>Écart maximal à la médiane du voisinage, en mètres (vide : 4 x la résolution).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="262" />
+            <location filename="../processing/help/__init__.py" line="276" />
             <source>Side of the median window in cells (odd); a second pass uses twice the window.</source>
             <translation>Côté de la fenêtre médiane en cellules (impair) ; une seconde passe utilise une fenêtre deux fois plus grande.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="264" />
+            <location filename="../processing/help/__init__.py" line="278" />
             <source>Neighbours within the threshold of a cell's height that keep it although it departs from the median (edges, corners, thin structures).</source>
             <translation>Voisins à moins du seuil de la hauteur d'une cellule qui la conservent bien qu'elle s'écarte de la médiane (arêtes, angles, structures fines).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="266" />
+            <location filename="../processing/help/__init__.py" line="280" />
             <source>With a confidence raster: cells below this confidence are removed.</source>
             <translation>Avec un raster de confiance : les cellules sous cette confiance sont supprimées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="267" />
+            <location filename="../processing/help/__init__.py" line="281" />
             <source>With a confidence raster: less confident cells are removed when they depart by more than the threshold from the median of the cells at least this confident in their 15 x 15 window (0: off).</source>
             <translation>Avec un raster de confiance : les cellules moins fiables sont supprimées lorsqu'elles s'écartent de plus que le seuil de la médiane des cellules ayant au moins cette confiance dans leur fenêtre de 15 x 15 (0 : désactivé).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="270" />
+            <location filename="../processing/help/__init__.py" line="284" />
             <source>Largest hole width (metres) that is interpolated; 0 fills nothing.</source>
             <translation>Largeur maximale de trou (mètres) interpolée ; 0 ne comble rien.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="271" />
+            <location filename="../processing/help/__init__.py" line="285" />
             <source>Height difference between two surfaces (a wall), metres: hole boundary cells that much above nearby boundary cells are not interpolated from.</source>
             <translation>Différence de hauteur entre deux surfaces (un mur), en mètres : les cellules du bord d'un trou situées d'autant plus haut que les cellules de bord voisines ne servent pas à l'interpolation.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="273" />
+            <location filename="../processing/help/__init__.py" line="287" />
             <source>Snap the cells of blurred height steps (between the two levels of their 5 x 5 window) to the nearer level.</source>
             <translation>Ramener les cellules des sauts de hauteur flous (entre les deux niveaux de leur fenêtre de 5 x 5) au niveau le plus proche.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="275" />
+            <location filename="../processing/help/__init__.py" line="289" />
             <source>Replace cells by a local plane fitted to the neighbours at their height (flat and pitched roofs, streets); steps stay sharp.</source>
             <translation>Remplacer les cellules par un plan local ajusté aux voisines à leur hauteur (toits plats et en pente, rues) ; les sauts restent nets.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="277" />
+            <location filename="../processing/help/__init__.py" line="291" />
             <source>Radius of the smoothing neighbourhood, cells.</source>
             <translation>Rayon du voisinage de lissage, en cellules.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="278" />
+            <location filename="../processing/help/__init__.py" line="292" />
             <source>Neighbours within this height of a cell belong to its surface, metres (empty: 2.5 x the resolution).</source>
             <translation>Les voisines à moins de cette hauteur d'une cellule appartiennent à sa surface, en mètres (vide : 2,5 x la résolution).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="280" />
+            <location filename="../processing/help/__init__.py" line="294" />
             <source>Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); the DTM is written on the DSM grid.</source>
             <translation>Taille de cellule du filtre de sol, en mètres (vide : max(1 m, résolution du MNS)) ; le MNT est écrit sur la grille du MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="282" />
+            <location filename="../processing/help/__init__.py" line="296" />
             <source>Largest opening radius of the ground filter, metres: more than half the width of the largest building.</source>
             <translation>Rayon d'ouverture maximal du filtre de sol, en mètres : plus de la moitié de la largeur du plus grand bâtiment.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="284" />
+            <location filename="../processing/help/__init__.py" line="298" />
             <source>Terrain slope (rise over run) the ground filter keeps as ground.</source>
             <translation>Pente du terrain (dénivelé sur distance) que le filtre de sol conserve comme sol.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="285" />
+            <location filename="../processing/help/__init__.py" line="299" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>MNS filtré (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="286" />
+            <location filename="../processing/help/__init__.py" line="300" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Modèle numérique de terrain facultatif (GeoTIFF, float32, grille du MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="287" />
+            <location filename="../processing/help/__init__.py" line="301" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>MNS normalisé facultatif : MNS moins MNT, hauteurs au-dessus du terrain.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="288" />
+            <location filename="../processing/help/__init__.py" line="302" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON : les statistiques du filtre (et celles du filtre de sol).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="289" />
+            <location filename="../processing/help/__init__.py" line="303" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Cellules supprimées comme valeurs aberrantes ou pour confiance insuffisante.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="290" />
+            <location filename="../processing/help/__init__.py" line="304" />
             <source>Hole cells interpolated.</source>
             <translation>Cellules de trous interpolées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="291" />
+            <location filename="../processing/help/__init__.py" line="305" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Trous plus larges que MAX_HOLE, laissés en NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="296" />
+            <location filename="../processing/help/__init__.py" line="310" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Construit un maillage triangulaire. À partir d'un MNS : un maillage 2,5D dont les sauts de hauteur sont des murs verticaux (aucun triangle n'enjambe jamais un saut) et dont les zones planes et lisses sont décimées par un quadtree restreint avec une borne garantie de l'erreur verticale au centre de chaque cellule ; couleurs des sommets issues d'une orthoimage facultative. À partir d'un nuage de points (LAS/LAZ ou EPT, par ex. l'appariement fusionné d'images obliques) : un maillage de Delaunay 2,5D par système de référence, vu selon sa direction de visée (couches superposées là où des systèmes voient la même surface ; non étanche). Écrit du PLY (binaire) ou de l'OBJ, dans le SCR ou dans un repère local dont le décalage est consigné dans l'en-tête ; truortho:trueortho le lit comme SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="305" />
+            <location filename="../processing/help/__init__.py" line="319" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>Raster MNS (SCR projeté) ou nuage de points (.las, .laz, ou un ept.json EPT).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="306" />
+            <location filename="../processing/help/__init__.py" line="320" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Orthoimage facultative (RVB) pour les couleurs des sommets d'un maillage de MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="307" />
+            <location filename="../processing/help/__init__.py" line="321" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Écart vertical maximal entre le maillage et le MNS en tout centre de cellule, en mètres (vide : la moitié de la résolution du MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="309" />
+            <location filename="../processing/help/__init__.py" line="323" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Plus petite différence de hauteur entre cellules voisines qui devient un mur, en mètres.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="310" />
+            <location filename="../processing/help/__init__.py" line="324" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Pente la plus forte conservée en triangles inclinés, en degrés : le seuil de saut vaut max(MIN_STEP, résolution x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="312" />
+            <location filename="../processing/help/__init__.py" line="326" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Plus grand bloc de cellules qu'une paire de triangles peut couvrir (une puissance de deux).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="313" />
+            <location filename="../processing/help/__init__.py" line="327" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Nuages de points : arête de triangle la plus longue, en mètres (vide : 4 x l'espacement médian des points).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="314" />
+            <location filename="../processing/help/__init__.py" line="328" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>SCR : coordonnées terrain (doubles PLY). Local : terrain moins un décalage consigné sous la forme 'comment offset E N H' (PLY) ou '# offset E N H' (OBJ), pour les visionneuses qui ont besoin de petits nombres.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="316" />
+            <location filename="../processing/help/__init__.py" line="330" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Le maillage : .ply (binaire petit-boutiste, 'comment crs ...') ou .obj ('# crs ...', couleurs des sommets sous la forme 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="318" />
+            <location filename="../processing/help/__init__.py" line="332" />
             <source>Number of vertices.</source>
             <translation>Nombre de sommets.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="319" />
+            <location filename="../processing/help/__init__.py" line="333" />
             <source>Number of triangles.</source>
             <translation>Nombre de triangles.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="320" />
+            <location filename="../processing/help/__init__.py" line="334" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Nombre de triangles de murs verticaux (maillages de MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="325" />
+            <location filename="../processing/help/__init__.py" line="339" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (Layer &gt; Add Layer &gt; Point Cloud, choose ept.json).</source>
             <translation>Exporte un MNS en nuage de points, un point par centre de cellule valide, avec les couleurs d'une orthoimage et une confiance par point issue d'un raster de confiance : LAS 1.4 ou LAZ (format de point 7, SCR en WKT, dimensions supplémentaires 'confidence' et 'system' (le système de référence), un VLR TruOrtho décrivant les systèmes de référence), lisible par PDAL, laspy, LAStools et CloudCompare. Un jeu de données Entwine Point Tile (EPT) est écrit à côté : les versions de QGIS sans PDAL (comme le QGIS 3.22 de Debian) l'ouvrent comme couche nuage de points (Couche &gt; Ajouter une couche &gt; Nuage de points, choisir ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="333" />
+            <location filename="../processing/help/__init__.py" line="347" />
             <source>DSM raster with a projected CRS.</source>
             <translation>Raster MNS dans un SCR projeté.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="334" />
+            <location filename="../processing/help/__init__.py" line="348" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Orthoimage facultative (RVB) pour les couleurs des points.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="335" />
+            <location filename="../processing/help/__init__.py" line="349" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Raster de confiance facultatif dans [0, 1], stocké comme dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="336" />
+            <location filename="../processing/help/__init__.py" line="350" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Le nuage de points (.laz compressé, ou .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="337" />
+            <location filename="../processing/help/__init__.py" line="351" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Dossier du jeu de données EPT (ept.json, ept-data/, ept-hierarchy/) ; laisser vide pour ne pas l'écrire.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="338" />
+            <location filename="../processing/help/__init__.py" line="352" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Chemin du fichier ept.json du jeu de données EPT.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="339" />
+            <location filename="../processing/help/__init__.py" line="353" />
             <source>Number of points written.</source>
             <translation>Nombre de points écrits.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="344" />
+            <location filename="../processing/help/__init__.py" line="358" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Fusionne des nuages de points de plusieurs systèmes de référence (par ex. les systèmes nadir et obliques de l'appariement dense) en un seul fichier LAS 1.4 / LAZ, en conservant le 'system' de chaque point (les fichiers qui n'en ont pas reçoivent l'index de leur fichier) et sa confiance ; éclaircit en option les doublons sur une grille de voxels en gardant le point le plus fiable de chaque voxel ; écrit en option un jeu de données EPT pour QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="350" />
+            <location filename="../processing/help/__init__.py" line="364" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>Fichiers LAS/LAZ dans un même SCR.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="351" />
+            <location filename="../processing/help/__init__.py" line="365" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Taille des voxels pour l'éclaircissement, en mètres (vide : conserver tous les points).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="352" />
+            <location filename="../processing/help/__init__.py" line="366" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Le nuage de points fusionné (.laz ou .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="353" />
+            <location filename="../processing/help/__init__.py" line="367" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Dossier facultatif pour un jeu de données EPT du nuage fusionné.</translation>
         </message>

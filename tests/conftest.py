@@ -56,6 +56,15 @@ def _ensure_truortho_importable() -> None:
 
 _ensure_truortho_importable()
 
+# pytest imports the repository root's __init__.py (a package) under the name of the checkout's
+# folder; a checkout in a folder named "dask" would then shadow Dask for every later import. Import
+# the real Dask first (core/parallel and its tests need it).
+try:
+    import dask  # noqa: F401
+    import distributed  # noqa: F401
+except ImportError:
+    pass
+
 try:
     import qgis.core  # noqa: F401
 

@@ -97,7 +97,7 @@ def _select(cand, max_images: int):
         return [(a, d, v) for _, a, d, v in sorted(cand, key=lambda t: t[1])]
     count = np.zeros(len(cand[0][0]), np.int64)
     left = list(range(len(cand)))
-    chosen = []
+    chosen: list[int] = []
     while left and len(chosen) < max_images:
         need = np.maximum(TARGET_VIEWS - count, 0)
         best = max(left, key=lambda k: (int(need[cand[k][0]].sum()), -cand[k][1]))

@@ -24,11 +24,14 @@ cancelled run writes nothing.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 
@@ -36,10 +39,21 @@ from ..errors import CancelledError, InputError
 from ..geometry.frame import parse_crs, require_metric
 from ..grid import RasterGrid
 from ..orientation import Orientation, as_orientation
+from ..parallel import (
+    EXECUTORS,
+    Digest,
+    Executor,
+    InProcessExecutor,
+    TileCache,
+    file_identity,
+    make_executor,
+    parse_memory,
+)
 from ..progress import Progress, as_progress
 from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
 from .levels import LevelPlan, coarse_windows, plan_levels, refine_windows
-from .matching import TileParams, View, choose_images, match_tile, sample_surface
+from .matching import TileParams, View, choose_images, sample_surface
+from .tiles import TileContext, TileTask, osgm_tile_task
 from .views import ImagePyramid, check_images, monotonic_radius2
 
 DSM_NODATA = -9999.0
@@ -90,7 +104,25 @@ class OsgmConfig:
     max_levels : int
         Upper bound of the pyramid depth.
     cache_bytes : int
-        Budget of decoded images kept in memory.
+        Budget of decoded images kept in memory (per process: in this one, or per Dask worker).
+    executor : {"inprocess", "local", "scheduler"}
+        Where the tiles run (:mod:`truortho.core.parallel`): in this process
+        (numba threads), on a local Dask cluster of worker processes on
+        127.0.0.1, or on the Dask scheduler ``scheduler_address``. The results
+        are identical.
+    scheduler_address : str, optional
+        ``tcp://127.0.0.1:8786``, ``tls://host:port`` or a scheduler file;
+        default ``$TRUORTHO_DASK_SCHEDULER``.
+    workers : int, optional
+        Worker processes of the local cluster (default the cores).
+    worker_memory : int or str, optional
+        Memory limit per local worker (``"4GiB"``); default 80 % of the machine / workers.
+    cache_dir : path, optional
+        Keep finished tiles there (content-addressed, see
+        :class:`~truortho.core.parallel.TileCache`) and reuse them on a rerun.
+        Default ``<DSM>.tiles/`` beside the DSM, removed when the run
+        succeeds or is cancelled and kept after a crash, so that a rerun with
+        the same inputs and parameters resumes.
     """
 
     resolution: float | None = None
@@ -114,6 +146,25 @@ class OsgmConfig:
     band: int | None = None
     max_levels: int = 5
     cache_bytes: int = 1 << 30
+    executor: str = "inprocess"
+    scheduler_address: str | None = None
+    workers: int | None = None
+    worker_memory: int | str | None = None
+    cache_dir: str | os.PathLike | None = None
+
+    #: fields that only say where and how the work runs, never what it computes (not in tile keys)
+    RUN_ONLY: ClassVar[tuple[str, ...]] = (
+        "executor",
+        "scheduler_address",
+        "workers",
+        "worker_memory",
+        "cache_dir",
+        "cache_bytes",
+    )
+
+    def result_fields(self) -> dict:
+        """The fields that decide the result (part of every tile's cache key)."""
+        return {k: v for k, v in dataclasses.asdict(self).items() if k not in self.RUN_ONLY}
 
     def validate(self) -> None:
         for name in ("resolution", "z_step", "z_margin"):
@@ -138,6 +189,11 @@ class OsgmConfig:
             raise InputError(f"median: expected an odd size >= 1, got {self.median!r}")
         if not 0 < float(self.max_view_angle) < 90:
             raise InputError(f"max_view_angle: expected degrees in (0, 90), got {self.max_view_angle!r}")
+        if self.executor not in EXECUTORS:
+            raise InputError(f"EXECUTOR: expected one of {', '.join(EXECUTORS)}, got {self.executor!r}")
+        if self.workers is not None and int(self.workers) < 1:
+            raise InputError(f"workers: expected at least 1, got {self.workers!r}")
+        parse_memory(self.worker_memory)
 
     def tile_params(self) -> TileParams:
         return TileParams(
@@ -359,6 +415,54 @@ class SystemResult:
     rgb: np.ndarray | None
     plan: LevelPlan
     tiles: int
+    max_volume: int = 0  # largest rows x cols x nd of a task (cost volume cells)
+
+
+class _LevelTasks(Sequence):
+    """The tile tasks of one level, built when the executor asks for them (bounded memory)."""
+
+    def __init__(self, tiles, g: RasterGrid, lv: int, plan: LevelPlan, params, cfg, prev_z, prev_filled, zsw):
+        self.tiles, self.g, self.lv, self.plan = tiles, g, lv, plan
+        self.params = plan.level_params(params, lv)
+        self.cfg, self.prev_z, self.prev_filled, self.zsw = cfg, prev_z, prev_filled, zsw
+        self.max_cells_levels = 0
+
+    def __len__(self) -> int:
+        return len(self.tiles)
+
+    def __getitem__(self, i):  # type: ignore[override]
+        tile = self.tiles[i]
+        plan, lv, g = self.plan, self.lv, self.g
+        r0, c0, nr, nc = tile.outer
+        if self.prev_z is None:
+            lo, hi = coarse_windows(
+                plan,
+                lv,
+                (nr, nc),
+                None if self.zsw is None else tuple(w[r0 : r0 + nr, c0 : c0 + nc] for w in self.zsw),
+            )
+            guide = None
+        else:
+            lo, hi = refine_windows(plan, lv, self.prev_z, (r0, c0, nr, nc))
+            assert self.prev_filled is not None
+            guide = _interpolate(self.prev_filled, (r0, c0, nr, nc)) if self.cfg.adaptive_p2 else None
+        search = lo <= hi
+        nd = int(max(3, (hi - lo + 1)[search].max())) if search.any() else 0
+        self.max_cells_levels = max(self.max_cells_levels, nr * nc * nd)
+        return TileTask(
+            lv,
+            tuple(tile.outer),
+            tuple(tile.core),
+            g.x_min + c0 * g.res,
+            g.y_max - r0 * g.res,
+            g.res,
+            lo,
+            hi,
+            plan.z_base,
+            plan.dz(lv),
+            self.params,
+            guide,
+        )
 
 
 def _match_system(
@@ -371,68 +475,65 @@ def _match_system(
     progress,
     z_surface_windows=None,
     want_colour=False,
+    executor: Executor | None = None,
+    cache: TileCache | None = None,
+    cache_base: str = "",
 ) -> SystemResult:
-    """Coarse-to-fine OSGM of one reference system over ``grid`` (system frame, local)."""
+    """Coarse-to-fine OSGM of one reference system over ``grid`` (system frame, local).
+
+    Every level is one ``executor.map_tiles`` call over its tiles (independent
+    given the coarser level's result); finished tiles go to ``cache`` when given.
+    """
+    from ..progress import SubProgress
+
+    executor = executor or InProcessExecutor()
     params = cfg.tile_params()
     views = _system_views(o, system)
+    ctx = TileContext(tuple(pyr.paths), tuple(pyr.sizes), pyr.band, pyr.max_bytes, views, pyramid=pyr)
+    base = ""
+    if cache is not None:
+        base = Digest(cache_base, ctx.digest().hexdigest(), np.asarray(system.Q, np.float64)).hexdigest()
     prev_z: np.ndarray | None = None
     prev_filled: np.ndarray | None = None
     n_tiles = 0
     total = sum(plan.grid(grid, lv).rows * plan.grid(grid, lv).cols for lv in plan.levels)
     done_cells = 0
+    max_volume = 0
     for lv in plan.levels:  # coarse to fine
+        if progress.cancelled():
+            raise CancelledError("OSGM cancelled")
         g = plan.grid(grid, lv)
-        dz = plan.dz(lv)
         z = np.full(g.shape, np.nan, np.float32)
         conf = np.full(g.shape, np.nan, np.float32)
         ts = int(cfg.tile_size)
         ov = max(16, ts // 8)
-        for tile in g.tiles(ts, ov):
-            if progress.cancelled():
-                raise CancelledError("OSGM cancelled")
-            r0, c0, nr, nc = tile.outer
-            if prev_z is None:
-                lo, hi = coarse_windows(
-                    plan,
-                    lv,
-                    (nr, nc),
-                    None
-                    if z_surface_windows is None
-                    else tuple(w[r0 : r0 + nr, c0 : c0 + nc] for w in z_surface_windows),
-                )
-                guide = None
-            else:
-                lo, hi = refine_windows(plan, lv, prev_z, (r0, c0, nr, nc))
-                assert prev_filled is not None
-                guide = _interpolate(prev_filled, (r0, c0, nr, nc)) if cfg.adaptive_p2 else None
-            tx0, ty0 = g.x_min + c0 * g.res, g.y_max - r0 * g.res
-            res = match_tile(
-                views,
-                pyr,
-                tx0,
-                ty0,
-                g.res,
-                lo,
-                hi,
-                plan.z_base,
-                dz,
-                plan.level_params(params, lv),
-                guide,
-                progress.cancelled,
+        tiles = g.tiles(ts, ov)
+        tasks = _LevelTasks(tiles, g, lv, plan, params, cfg, prev_z, prev_filled, z_surface_windows)
+        sub = SubProgress(progress, done_cells / total, (done_cells + g.rows * g.cols) / total)
+        try:
+            results = executor.map_tiles(
+                osgm_tile_task,
+                tasks,
+                sub,
+                shared=ctx,
+                cache=cache,
+                key=(lambda t: t.key(base)) if cache is not None else None,
+                label=f"{system.name}: level {lv}",
             )
-            if progress.cancelled():
-                raise CancelledError("OSGM cancelled")
-            ins, core = tile.inner_slices, tile.core_slices
-            z[core] = res.z[ins]
-            conf[core] = res.confidence[ins]
-            n_tiles += 1
-            done_cells += tile.core[2] * tile.core[3]
-            progress.update(done_cells / total, f"{system.name}: level {lv} tile {tile.index}")
+        except CancelledError:
+            raise CancelledError("OSGM cancelled") from None
+        for tile, (zt, ct) in zip(tiles, results, strict=True):
+            core = tile.core_slices
+            z[core] = zt
+            conf[core] = ct
+        n_tiles += len(tiles)
+        done_cells += g.rows * g.cols
+        max_volume = max(max_volume, tasks.max_cells_levels)
         prev_z = z
         prev_filled = _fill_nearest(z)
     assert prev_z is not None
     rgb = _colours(views, pyr, grid, prev_z, cfg) if want_colour else None
-    return SystemResult(grid, prev_z, conf, rgb, plan, n_tiles)
+    return SystemResult(grid, prev_z, conf, rgb, plan, n_tiles, max_volume)
 
 
 def _fill_nearest(z: np.ndarray) -> np.ndarray:
@@ -520,6 +621,7 @@ def run_osgm(
     image_root=None,
     z_surface=None,
     progress: Progress | None = None,
+    executor: Executor | None = None,
 ) -> OsgmResult:
     """Object-space semi-global multi-image matching of an oriented block.
 
@@ -540,6 +642,9 @@ def run_osgm(
         A coarse DSM/DTM raster: per-cell search bounds ``[min - margin, max + margin]``
         of its 3 x 3 neighbourhood on the coarsest level.
     progress : Progress, optional
+    executor : Executor, optional
+        Runs the tiles (:mod:`truortho.core.parallel`); default one made from
+        ``config.executor`` (in-process unless told otherwise) and closed at the end.
 
     Returns
     -------
@@ -580,6 +685,44 @@ def run_osgm(
     off = o.offset
     local = RasterGrid(grid.x_min - off[0], grid.y_max - off[1], res, grid.rows, grid.cols, o.crs)
     pyr = ImagePyramid(paths, sizes, cfg.band, cfg.cache_bytes)
+    own_executor = executor is None
+    if executor is None:
+        executor = make_executor(
+            cfg.executor,
+            cfg.scheduler_address,
+            n_workers=cfg.workers,
+            memory_limit=parse_memory(cfg.worker_memory),
+        )
+    if cfg.cache_dir is not None:
+        cache = TileCache(cfg.cache_dir)
+    else:
+        cache = TileCache(f"{outputs.dsm}.tiles", remove_when_done=True)
+    # everything a tile's result depends on besides its own inputs: block, parameters, grid, Z surface
+    cache_base = Digest(
+        "osgm-run",
+        o.to_dict(),
+        cfg.result_fields(),
+        [local.x_min, local.y_max, local.res, local.rows, local.cols],
+        None if z_surface is None else list(file_identity(z_surface)),
+    ).hexdigest()
+    try:
+        return _run_systems(
+            o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
+            z_surface, progress, t0,
+        )  # fmt: skip
+    except CancelledError:
+        cache.finish()
+        raise
+    finally:
+        if own_executor:
+            executor.close()
+
+
+def _run_systems(
+    o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
+    z_surface, progress, t0,
+) -> OsgmResult:  # fmt: skip
+    off = o.offset
     systems = reference_systems(o, cfg.oblique, cfg.oblique_group_angle)
     weights = [1.0] + [0.5] * (len(systems) - 1)
     wsum = sum(weights)
@@ -601,6 +744,9 @@ def run_osgm(
         SubProgress(progress, 0, 0.8 * weights[0] / wsum),
         zsw,
         want_colour=True,
+        executor=executor,
+        cache=cache,
+        cache_base=cache_base,
     )
     dsm = np.where(np.isfinite(nadir.z), nadir.z + off[2], np.nan).astype(np.float32)
     conf = np.where(np.isfinite(nadir.z), np.clip(np.nan_to_num(nadir.confidence), 0, 1), np.nan).astype(
@@ -623,8 +769,9 @@ def run_osgm(
         sub = SubProgress(progress, pos, pos + 0.8 * w / wsum)
         pos += 0.8 * w / wsum
         cloud = _oblique_points(
-            o, s, pyr, local, zmin, zmax, dz, cfg, sub, want_rgb=outputs.point_cloud is not None
-        )
+            o, s, pyr, local, zmin, zmax, dz, cfg, sub, outputs.point_cloud is not None,
+            executor, cache, cache_base,
+        )  # fmt: skip
         clouds.append(cloud)
         sys_stats.append(
             {
@@ -658,8 +805,13 @@ def run_osgm(
         "systems": sys_stats,
         "images": len(o.images),
         "image_reads": pyr.reads,
+        "executor": executor.describe() if hasattr(executor, "describe") else type(executor).__name__,
+        "cache_hits": cache.hits,
+        "cache_tiles_written": cache.written,
+        "task_volume_bytes": 4 * nadir.max_volume,
         "seconds": time.perf_counter() - t0,
     }
+    cache.finish()
     progress.update(1.0, "OSGM done")
     return OsgmResult(grid, stats, written)
 
@@ -715,7 +867,9 @@ def _surface_windows(path, grid: RasterGrid, plan: LevelPlan, cfg: OsgmConfig, o
     return lo - margin, hi + margin
 
 
-def _oblique_points(o, system, pyr, local: RasterGrid, zmin, zmax, dz, cfg, progress, want_rgb):
+def _oblique_points(
+    o, system, pyr, local: RasterGrid, zmin, zmax, dz, cfg, progress, want_rgb, executor, cache, cache_base
+):
     """Points (world xyz, rgb, confidence) of one oblique reference system."""
     Q = system.Q
     x0, y0, x1, y1 = local.extent
@@ -725,7 +879,9 @@ def _oblique_points(o, system, pyr, local: RasterGrid, zmin, zmax, dz, cfg, prog
     res = local.res
     sgrid = RasterGrid.from_extent((s_lo[0], s_lo[1], s_hi[0], s_hi[1]), res, None)
     plan = plan_levels(float(s_lo[2]), float(s_hi[2]), dz, sgrid, cfg.max_levels)
-    r = _match_system(o, system, pyr, sgrid, plan, cfg, progress, None, want_colour=want_rgb)
+    r = _match_system(
+        o, system, pyr, sgrid, plan, cfg, progress, None, want_rgb, executor, cache, cache_base
+    )
     ok = np.isfinite(r.z)
     X, Y = sgrid.centres()
     S = np.column_stack([X[ok], Y[ok], r.z[ok].astype(np.float64)])

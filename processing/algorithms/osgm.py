@@ -21,6 +21,7 @@ from qgis.core import (
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterRasterLayer,
+    QgsProcessingParameterString,
 )
 
 from ..feedback import FeedbackProgress, core_errors
@@ -51,6 +52,8 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
     P2 = "P2"
     MAX_IMAGES = "MAX_IMAGES"
     TILE_SIZE = "TILE_SIZE"
+    EXECUTOR = "EXECUTOR"
+    SCHEDULER_ADDRESS = "SCHEDULER_ADDRESS"
     DSM = "DSM"
     CONFIDENCE = "CONFIDENCE"
     ORTHOIMAGE = "ORTHOIMAGE"
@@ -59,6 +62,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
 
     PATH_CHOICES = [8, 16]
     OBLIQUE_CHOICES = ["none", "auto"]
+    EXECUTOR_CHOICES = ["inprocess", "local", "scheduler"]
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         num = QgsProcessingParameterNumber
@@ -159,6 +163,33 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
             num(self.TILE_SIZE, tr("Tile size (cells)"), num.Integer, 256, minValue=32, maxValue=8192),
             advanced=True,
         )
+        self.add(
+            QgsProcessingParameterEnum(
+                self.EXECUTOR,
+                tr("Run tiles on"),
+                options=[
+                    tr("inprocess: this process (all cores)"),
+                    tr("local: a Dask cluster of worker processes on this computer"),
+                    tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
+                ],
+                defaultValue=0,
+            ),
+            advanced=True,
+        )
+        from ...core.parallel import SCHEDULER_ENV
+
+        self.add(
+            QgsProcessingParameterString(
+                self.SCHEDULER_ADDRESS,
+                tr(
+                    "Dask scheduler address (tls://host:port or scheduler file; "
+                    "empty = TRUORTHO_DASK_SCHEDULER)"
+                ),
+                defaultValue=os.environ.get(SCHEDULER_ENV, ""),
+                optional=True,
+            ),
+            advanced=True,
+        )
         self.add(QgsProcessingParameterRasterDestination(self.DSM, tr("DSM (OSGM)")))
         self.add(
             QgsProcessingParameterRasterDestination(
@@ -244,6 +275,8 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
 
         from ...core.osgm import OsgmConfig, OsgmOutputs, run_osgm
 
+        address = (self.parameterAsString(parameters, self.SCHEDULER_ADDRESS, context) or "").strip()
+
         cfg = OsgmConfig(
             resolution=res or None,
             z_step=z_step or None,
@@ -255,6 +288,8 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
             max_images=self.parameterAsInt(parameters, self.MAX_IMAGES, context),
             oblique=self.OBLIQUE_CHOICES[self.parameterAsEnum(parameters, self.OBLIQUE, context)],
             tile_size=self.parameterAsInt(parameters, self.TILE_SIZE, context),
+            executor=self.EXECUTOR_CHOICES[self.parameterAsEnum(parameters, self.EXECUTOR, context)],
+            scheduler_address=address or None,
         )
         outputs = OsgmOutputs(dsm=dsm, confidence=confidence, orthoimage=ortho, point_cloud=cloud)
         cfg.validate()  # the core's checks (penalties, output types, ...), before the orientation is read

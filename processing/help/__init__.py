@@ -189,6 +189,20 @@ HELP: dict[str, dict] = {
             "nadir); memory and time grow with it.",
             "TILE_SIZE": "Tile side in cells; memory grows with its square, the number of search heights "
             "and MAX_IMAGES.",
+            "EXECUTOR": "Where the tiles are matched; the DSM and confidence are identical with every "
+            "choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). "
+            "local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only "
+            "(one worker per core, a memory limit each). scheduler: an existing Dask cluster given by "
+            "SCHEDULER_ADDRESS; its workers must read the images at the same paths (shared storage) and "
+            "have TruOrtho installed. A worker that dies has its tiles recomputed by the others. "
+            "Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with "
+            "the same inputs and parameters after a crash reuses them.",
+            "SCHEDULER_ADDRESS": "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
+            "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
+            "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
+            "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
+            "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
+            "that is not on this computer is refused.",
             "DSM": "The raw DSM: GeoTIFF, float32, in the orientation's CRS, nodata -9999.",
             "CONFIDENCE": "Optional confidence GeoTIFF (float32 in [0, 1], nodata -1) on the DSM grid, for "
             "truortho:dsmfilter.",

@@ -144,6 +144,10 @@ BAD_INPUT = {
     "p2 below p1": ({"P1": 600, "P2": 500}, "P2"),
     "p2 too large": ({"P2": 5000}, "P2"),
     "two outputs, one file": ({"CONFIDENCE": "dsm.tif"}, "same path"),
+    "scheduler off this machine without TLS": (
+        {"EXECUTOR": 2, "SCHEDULER_ADDRESS": "tcp://198.51.100.7:8786"},
+        "unauthenticated",
+    ),
 }
 FILE_PARAMETERS = ("ORIENTATION", "POINT_CLOUD", "CONFIDENCE")
 
@@ -170,3 +174,28 @@ def test_osgm_bad_input(truortho_provider, scene_dir, tmp_path, case):
     with pytest.raises(QgsProcessingException, match=match):
         run(params)
     assert not any(tmp_path.iterdir())
+
+
+@pytest.mark.slow
+def test_osgm_on_a_local_dask_cluster_gives_the_in_process_dsm(truortho_provider, scene_dir, tmp_path):
+    """EXECUTOR = local (2 worker processes on 127.0.0.1) from Processing: the same DSM, bit for bit."""
+    from truortho.core.rasterio_io import read_raster
+
+    _scene, root = scene_dir
+    dsms = {}
+    for executor in (0, 1):
+        res = run(
+            {
+                "ORIENTATION": str(root / "orientation.json"),
+                "RESOLUTION": RES,
+                "TILE_SIZE": 32,
+                "EXECUTOR": executor,
+                "DSM": str(tmp_path / f"dsm{executor}.tif"),
+            }
+        )
+        stats = json.loads(res["STATISTICS"])
+        assert stats["tiles"] > 2
+        dsms[executor] = read_raster(res["DSM"])[0]
+    assert stats["executor"].startswith("local Dask cluster")
+    assert np.array_equal(dsms[0], dsms[1], equal_nan=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["dsm0.tif", "dsm1.tif"]  # no scratch tiles left

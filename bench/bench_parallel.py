@@ -1,0 +1,171 @@
+"""Benchmark of tile-parallel OSGM: in-process, and a local Dask cluster of 1 and 2 worker processes.
+
+Not a test. Run from the repository root with the project's interpreter::
+
+    source scripts/env.sh
+    python -P bench/bench_parallel.py [--scale 2] [--resolution 0.25] [--tile 128] [--skip-inprocess]
+
+The scene is the default synthetic scene (``core/synthetic``: 120 x 100 m, 7 buildings and a
+tower) with its extent scaled by ``--scale`` in both directions (default 2: 4x the area, 4x the
+buildings) at the same flight parameters, so it has about 4x the images (84 of 640 x 480 px). The
+DSM cell defaults to twice the GSD (0.25 m, 960 x 800 cells): at the GSD one in-process run alone
+takes about 9 minutes here.
+
+Each configuration runs ``run_osgm`` on the same scene and grid (the DSM must be bit-identical in
+all of them, which is checked):
+
+* ``inprocess``: this process, numba kernels on all cores (the default executor);
+* ``dask-1`` and ``dask-2``: a LocalCluster of 1 and 2 worker processes on 127.0.0.1, one thread
+  and ``NUMBA_NUM_THREADS=1`` each, so the speed-up is only the tile parallelism.
+
+Printed: wall time of ``run_osgm`` (cluster start-up excluded, measured separately), peak resident
+memory of every worker process (``VmHWM``) and of this process (``ru_maxrss``), the parallel efficiency
+``t(1 worker) / (2 t(2 workers))``, and per-tile costs of the finest level from the Dask task
+stream of the 1-worker run (seconds per tile and per million cells, all levels included). The
+machine is shared (2 cores): wall times are indicative. Results go to ``bench/results/parallel.json``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def _maxrss_mb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+
+
+def _peak_rss_mb() -> float:
+    """VmHWM of this process: its own peak (ru_maxrss survives exec, so a spawned worker would
+    report its parent's peak)."""
+    with open("/proc/self/status") as f:
+        for line in f:
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def _run(scene, folder, out, res, tile, executor):
+    from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
+
+    t = time.perf_counter()
+    r = run_osgm(
+        scene.orientation,
+        OsgmConfig(resolution=res, tile_size=tile),
+        scene.extent_world(),
+        OsgmOutputs(dsm=out),
+        folder,
+        executor=executor,
+    )
+    return time.perf_counter() - t, r
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scale", type=float, default=2.0, help="extent factor per axis (2 = 4x the area)")
+    ap.add_argument("--resolution", type=float, default=None, help="DSM cell (default twice the GSD)")
+    ap.add_argument("--tile", type=int, default=128)
+    ap.add_argument("--skip-inprocess", action="store_true")
+    args = ap.parse_args(argv)
+
+    from truortho.core.parallel import LocalDaskExecutor
+    from truortho.core.rasterio_io import read_raster
+    from truortho.core.synthetic import SceneConfig, make_scene
+
+    base = SceneConfig()
+    x0, y0, x1, y1 = base.extent
+    s = args.scale
+    cfg = SceneConfig(
+        extent=(x0 * s, y0 * s, x1 * s, y1 * s), n_buildings=int(round(base.n_buildings * s * s))
+    )
+    t = time.perf_counter()
+    scene = make_scene(cfg)
+    tmp = Path(tempfile.mkdtemp(prefix="bench_parallel_"))
+    folder = tmp / "scene"
+    folder.mkdir()
+    scene.write(folder)
+    res = args.resolution or 2 * cfg.gsd
+    n_img = len(scene.orientation.images)
+    w, h = cfg.image_size
+    print(
+        f"scene: {(x1 - x0) * s:.0f} x {(y1 - y0) * s:.0f} m ({s * s:.1f}x the default area), "
+        f"{cfg.n_buildings} buildings, {n_img} images of {w} x {h} px, GSD {cfg.gsd:.3f} m; "
+        f"made in {time.perf_counter() - t:.1f} s"
+    )
+    results: dict = {"scene": {"scale": s, "images": n_img, "image_size": [w, h], "gsd": cfg.gsd},
+                     "resolution": res, "tile": args.tile, "runs": {}}  # fmt: skip
+    products = {}
+    if not args.skip_inprocess:
+        wall, r = _run(scene, folder, tmp / "inprocess.tif", res, args.tile, None)
+        products["inprocess"] = read_raster(tmp / "inprocess.tif")[0]
+        results["runs"]["inprocess"] = {"wall": wall, "peak_mb_this_process": _maxrss_mb()}
+        st = r.stats
+        print(f"inprocess: {wall:.1f} s, {st['cols']} x {st['rows']} cells, {st['tiles']} tiles, "
+              f"{st['levels']} levels; peak RSS of this process {_maxrss_mb():.0f} MB")  # fmt: skip
+        results["grid"] = [r.stats["cols"], r.stats["rows"], r.stats["tiles"], r.stats["levels"]]
+        results["task_volume_bytes"] = r.stats["task_volume_bytes"]
+    for n in (1, 2):
+        ex = LocalDaskExecutor(n_workers=n, memory_limit="4GiB", numba_threads=1)
+        t = time.perf_counter()
+        client = ex._client()
+        client.run(lambda: __import__("truortho.core.osgm.tiles"))  # imports (numba cache) before timing
+        start = time.perf_counter() - t
+        from distributed import get_task_stream
+
+        with get_task_stream(client) as stream:
+            wall, r = _run(scene, folder, tmp / f"dask{n}.tif", res, args.tile, ex)
+        tasks = [
+            (d["key"], sum(x["stop"] - x["start"] for x in d["startstops"] if x["action"] == "compute"))
+            for d in stream.data
+            if str(d["key"]).startswith("truortho-tile-")
+        ]
+        peaks = sorted(client.run(_peak_rss_mb).values())
+        ex.close()
+        products[f"dask-{n}"] = read_raster(tmp / f"dask{n}.tif")[0]
+        results["runs"][f"dask-{n}"] = {"wall": wall, "startup": start, "peak_mb_per_worker": peaks}
+        compute = sum(c for _k, c in tasks)
+        results["runs"][f"dask-{n}"]["task_compute_s"] = compute
+        print(f"dask-{n}: {wall:.1f} s (+ {start:.1f} s cluster start), peak RSS per worker "
+              + ", ".join(f"{p:.0f} MB" for p in peaks)
+              + f"; tile compute time summed over the workers {compute:.1f} s")  # fmt: skip
+        if n == 1:
+            secs = np.array([c for _k, c in tasks])
+            cells = r.stats["rows"] * r.stats["cols"]
+            results["tasks"] = {
+                "n": len(secs), "compute_s": float(secs.sum()), "mean_s": float(secs.mean()),
+                "max_s": float(secs.max()), "s_per_mcell": float(secs.sum() / cells * 1e6), "cells": cells,
+            }  # fmt: skip
+            # what the client does between and around the tasks: level set-up, assembling, colours, writing
+            serial = wall - float(secs.sum())
+            print(f"  client-side time outside the tiles: {serial:.1f} s")
+            results["serial_s"] = serial
+            print(f"  tiles (all levels): {len(secs)}, compute {secs.sum():.1f} s, mean {secs.mean():.2f} s, "
+                  f"max {secs.max():.2f} s; {secs.sum() / cells * 1e6:.1f} s per million DSM cells "
+                  f"(one core, all levels)")  # fmt: skip
+    ref = next(iter(products.values()))
+    same = all(np.array_equal(ref, p, equal_nan=True) for p in products.values())
+    t1, t2 = results["runs"]["dask-1"]["wall"], results["runs"]["dask-2"]["wall"]
+    eff = t1 / (2 * t2)
+    results["efficiency_2"] = eff
+    results["identical"] = same
+    c1, c2 = results["runs"]["dask-1"]["task_compute_s"], results["runs"]["dask-2"]["task_compute_s"]
+    # the same tiles take longer when the cores are shared (other processes, the client): c2 / c1 > 1
+    results["compute_inflation_2"] = c2 / c1
+    print(f"the same tiles took {c2 / c1:.2f}x the compute time with 2 workers (core contention)")
+    print(f"parallel efficiency with 2 workers: t1 / (2 t2) = {t1:.1f} / (2 x {t2:.1f}) = {eff:.2f}; "
+          f"DSMs bit-identical: {same}")  # fmt: skip
+    out = Path(__file__).resolve().parent / "results"
+    out.mkdir(exist_ok=True)
+    (out / "parallel.json").write_text(json.dumps(results, indent=1))
+    return 0 if same else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

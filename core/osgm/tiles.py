@@ -1,0 +1,173 @@
+"""OSGM tile tasks that can run anywhere: in this process or on a Dask worker.
+
+One task matches one tile of one pyramid level (:func:`osgm_tile_task`). Its
+inputs are plain data: the :class:`TileContext` of the reference system
+(image paths and sizes, the views already rotated into the system, the
+matching band; shared by all tasks of a level) and a :class:`TileTask` (the
+tile's corner, cell size, per-cell Z windows ``lo``/``hi`` and the guide
+heights, both computed from the previous level's result by the caller, the
+level's parameters, the core window). It returns ``(z, confidence)`` of the
+tile's *core* cells, float32.
+
+Given the previous level, the tiles of one level are independent, so a
+level is one :meth:`~truortho.core.parallel.Executor.map_tiles` call.
+
+On a worker, the images are opened through an :class:`~.views.ImagePyramid`
+kept per worker process (:func:`worker_pyramid`, a small LRU keyed by the
+paths), so the decoded images are reused by the next tiles; in this process
+the run's own pyramid is used (it is not pickled with the context).
+
+Memory of one task (:func:`task_memory`): the cost volume and the aggregated
+volume, ``rows x cols x nd`` uint16 each (``nd`` the widest band of Z levels
+of a cell: up to :data:`~.levels.MAX_BAND` below the coarsest level, at most
+about :data:`~.levels.COARSE_LEVELS` on it), i.e. ``cells x nd x 2 bytes x
+2``, plus the image windows (float32, up to ``max_images`` of them) and a few
+per-cell arrays. With the default tile of 256 cells (+ 2 x 32 overlap) and
+``nd = 192``: 320² x 192 x 4 B = 79 MB, plus the windows. A worker also keeps
+its decoded images (``cache_bytes``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections import OrderedDict
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..parallel import Digest, current_cancel, file_identity
+from .matching import TileParams, View, match_tile
+from .views import ImagePyramid
+
+
+@dataclass
+class TileContext:
+    """What all tasks of one reference system share (pickled once per level for Dask)."""
+
+    paths: tuple[str, ...]
+    sizes: tuple[tuple[int, int], ...]
+    band: int | None
+    cache_bytes: int
+    views: list[View]
+    #: the run's own pyramid, used in this process; never pickled (workers open their own)
+    pyramid: ImagePyramid | None = field(default=None, compare=False)
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state["pyramid"] = None
+        return state
+
+    def pyramid_key(self) -> tuple:
+        return (tuple(self.paths), tuple(tuple(s) for s in self.sizes), self.band, int(self.cache_bytes))
+
+    def digest(self) -> Digest:
+        """Identity of the inputs: image files (path, size, mtime), views, band."""
+        d = Digest(
+            "osgm-context", [file_identity(p) for p in self.paths], [list(s) for s in self.sizes], self.band
+        )
+        for v in self.views:
+            d.add(
+                [
+                    v.index,
+                    np.asarray(v.R, np.float64),
+                    np.asarray(v.C, np.float64),
+                    np.asarray(v.camera.params, np.float64),
+                    [int(v.camera.width), int(v.camera.height)],
+                    float(v.r2max),
+                    float(v.axis_cos),
+                ]
+            )
+        return d
+
+
+@dataclass
+class TileTask:
+    """One tile of one level: inputs of :func:`match_tile` and where its core lies."""
+
+    level: int
+    outer: tuple[int, int, int, int]  # (r0, c0, rows, cols) in the level's grid
+    core: tuple[int, int, int, int]
+    x0: float  # outer north-west corner (system frame)
+    y0: float
+    res: float
+    lo: np.ndarray  # (rows, cols) int32 absolute Z levels
+    hi: np.ndarray
+    z_base: float
+    dz: float
+    params: TileParams
+    guide: np.ndarray | None  # (rows, cols) float32 heights of the coarser level, or None
+
+    def inner(self) -> tuple[slice, slice]:
+        r = self.core[0] - self.outer[0]
+        c = self.core[1] - self.outer[1]
+        return slice(r, r + self.core[2]), slice(c, c + self.core[3])
+
+    def key(self, base: str) -> str:
+        """Cache key: ``base`` (inputs and parameters of the run) + every input of this task."""
+        return (
+            Digest(
+                base,
+                "osgm-tile",
+                self.level,
+                list(self.outer),
+                list(self.core),
+                float(self.x0),
+                float(self.y0),
+                float(self.res),
+                self.lo,
+                self.hi,
+                float(self.z_base),
+                float(self.dz),
+                dataclasses.asdict(self.params),
+                self.guide,
+            )
+        ).hexdigest()
+
+
+_PYRAMIDS: OrderedDict = OrderedDict()
+_MAX_PYRAMIDS = 2
+
+
+def worker_pyramid(ctx: TileContext) -> ImagePyramid:
+    """The run's pyramid in this process, else this worker process's own (LRU of two)."""
+    if ctx.pyramid is not None:
+        return ctx.pyramid
+    k = ctx.pyramid_key()
+    pyr = _PYRAMIDS.get(k)
+    if pyr is None:
+        pyr = ImagePyramid(list(ctx.paths), list(ctx.sizes), ctx.band, ctx.cache_bytes)
+        _PYRAMIDS[k] = pyr
+        while len(_PYRAMIDS) > _MAX_PYRAMIDS:
+            _PYRAMIDS.popitem(last=False)
+    else:
+        _PYRAMIDS.move_to_end(k)
+    return pyr
+
+
+def osgm_tile_task(ctx: TileContext, task: TileTask) -> tuple[np.ndarray, np.ndarray]:
+    """Match one tile; ``(z, confidence)`` of its core cells (float32, NaN where rejected)."""
+    res = match_tile(
+        ctx.views,
+        worker_pyramid(ctx),
+        task.x0,
+        task.y0,
+        task.res,
+        task.lo,
+        task.hi,
+        task.z_base,
+        task.dz,
+        task.params,
+        task.guide,
+        current_cancel(),
+    )
+    ins = task.inner()
+    return np.ascontiguousarray(res.z[ins]), np.ascontiguousarray(res.confidence[ins])
+
+
+def task_memory(rows: int, cols: int, nd: int, n_images: int, window_pixels: int) -> int:
+    """Bytes one task needs at most (module docstring): volumes, windows, per-cell arrays."""
+    cells = int(rows) * int(cols)
+    volumes = cells * int(nd) * 2 * 2  # cost + aggregated, uint16
+    windows = int(n_images) * int(window_pixels) * 4  # float32 image windows
+    per_cell = cells * 4 * 16  # lo, hi, z0, guide, remapped slices, level, confidence, ...
+    return volumes + windows + per_cell
