@@ -288,6 +288,7 @@ def _fill_report(
     from .rasterio_io import read_raster
 
     if orient_report is not None:
+        report.data["orientation"] = orient_report.data
         report.summary.update(orient_report.summary)
         report.tables.extend(orient_report.tables)
         report.figures.extend(orient_report.figures)
@@ -297,6 +298,9 @@ def _fill_report(
     report.summary["images oriented"] = len(orientation.images)
     report.summary["CRS"] = orientation.crs
     s = osgm.stats
+    report.data["osgm"] = s
+    report.data["filter"] = fstats.as_dict()
+    report.data["trueortho"] = {k: v for k, v in tres.stats.items() if isinstance(v, int | float | str)}
     report.summary["DSM resolution [m]"] = s["resolution"]
     report.summary["DSM completeness (raw) [%]"] = round(100 * s["completeness"], 2)
     dsm, grid, _ = read_raster(paths["dsm"])
