@@ -24,6 +24,16 @@
             <translation>Werkzeuge</translation>
         </message>
         <message>
+            <location filename="../processing/algorithms/base.py" line="57" />
+            <source>Ground control points</source>
+            <translation>Passpunkte</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/base.py" line="63" />
+            <source>GCP image measurements (table)</source>
+            <translation>Bildmessungen der Passpunkte (Tabelle)</translation>
+        </message>
+        <message>
             <location filename="../processing/algorithms/dsmfilter.py" line="31" />
             <source>Filter DSM (outliers, holes, smoothing, DTM)</source>
             <translation>DOM filtern (Ausreißer, Lücken, Glättung, DGM)</translation>
@@ -269,11 +279,6 @@
             <translation>In KBS umprojizieren</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="65" />
-            <source>Ground control points</source>
-            <translation>Passpunkte</translation>
-        </message>
-        <message>
             <location filename="../processing/algorithms/importgcps.py" line="70" />
             <source>GCP image measurements</source>
             <translation>Bildmessungen der Passpunkte</translation>
@@ -289,87 +294,82 @@
             <translation>CHECK_POINTS: unbekannte(r) Passpunktname(n) {}; die Datei enthält {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="45" />
+            <location filename="../processing/algorithms/importorientation.py" line="44" />
             <source>Import orientation</source>
             <translation>Orientierung importieren</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="61" />
+            <location filename="../processing/algorithms/importorientation.py" line="60" />
             <source>Orientation file (COLMAP, Orthority CSV, OpenSfM)</source>
             <translation>Orientierungsdatei (COLMAP, Orthority-CSV, OpenSfM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="65" />
+            <location filename="../processing/algorithms/importorientation.py" line="64" />
             <source>Interior parameter file (Orthority)</source>
             <translation>Parameterdatei der inneren Orientierung (Orthority)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="70" />
+            <location filename="../processing/algorithms/importorientation.py" line="69" />
             <source>CRS of the input (when the file has none)</source>
             <translation>KBS der Eingabe (wenn die Datei keins angibt)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="76" />
+            <location filename="../processing/algorithms/importorientation.py" line="75" />
             <source>Image folder</source>
             <translation>Bildordner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="89" />
-            <source>GCP image measurements (table)</source>
-            <translation>Bildmessungen der Passpunkte (Tabelle)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/importorientation.py" line="97" />
+            <location filename="../processing/algorithms/importorientation.py" line="84" />
             <source>Footprint height</source>
             <translation>Höhe der Bildabdeckungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="104" />
+            <location filename="../processing/algorithms/importorientation.py" line="91" />
             <source>Orientation (JSON)</source>
             <translation>Orientierung (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="108" />
+            <location filename="../processing/algorithms/importorientation.py" line="95" />
             <source>Cameras</source>
             <translation>Kameras</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="112" />
+            <location filename="../processing/algorithms/importorientation.py" line="99" />
             <source>Footprints</source>
             <translation>Bildabdeckungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="138" />
+            <location filename="../processing/algorithms/importorientation.py" line="125" />
             <source>The orientation has no CRS: it stays in its arbitrary (local) frame. Give CRS (or a georef.json) to georeference it.</source>
             <translation>Die Orientierung hat kein KBS: sie bleibt in ihrem beliebigen (lokalen) System. Geben Sie CRS (oder eine georef.json) an, um sie zu georeferenzieren.</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="154" />
+            <location filename="../processing/algorithms/importorientation.py" line="141" />
             <source>OBSERVATIONS given without a GCPS layer</source>
             <translation>OBSERVATIONS ohne GCPS-Layer angegeben</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="128" />
+            <location filename="../processing/algorithms/importorientation.py" line="115" />
             <source>Read {} images, {} cameras, {} sparse points</source>
             <translation>{} Bilder, {} Kameras, {} Punkte der dünnen Punktwolke gelesen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="158" />
+            <location filename="../processing/algorithms/importorientation.py" line="145" />
             <source>GCPs need a georeferenced orientation: give CRS for the input</source>
             <translation>Passpunkte erfordern eine georeferenzierte Orientierung: geben Sie CRS für die Eingabe an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="135" />
+            <location filename="../processing/algorithms/importorientation.py" line="122" />
             <source>{}: the orientation contains no images</source>
             <translation>{}: die Orientierung enthält keine Bilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="164" />
+            <location filename="../processing/algorithms/importorientation.py" line="151" />
             <source>{} GCPs with {} image measurements</source>
             <translation>{} Passpunkte mit {} Bildmessungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="200" />
+            <location filename="../processing/algorithms/importorientation.py" line="187" />
             <source>Image {} does not see the plane at height {}</source>
             <translation>Bild {} sieht die Ebene in Höhe {} nicht</translation>
         </message>
@@ -479,87 +479,82 @@
             <translation>{} Zellen -&gt; {} Eckpunkte ({:.1%} der Zellen), {} Dreiecke, davon {} Wanddreiecke; Sprungschwelle {:.2f} m, Höhenfehler &lt;= {:.3f} m</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="55" />
+            <location filename="../processing/algorithms/orientimages.py" line="54" />
             <source>Orient images (bundle block adjustment)</source>
             <translation>Bilder orientieren (Bündelblockausgleichung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="82" />
+            <location filename="../processing/algorithms/orientimages.py" line="81" />
             <source>Image files (instead of a folder)</source>
             <translation>Bilddateien (statt eines Ordners)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="88" />
+            <location filename="../processing/algorithms/orientimages.py" line="87" />
             <source>Interior orientation file (optional)</source>
             <translation>Datei der inneren Orientierung (optional)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="103" />
+            <location filename="../processing/algorithms/orientimages.py" line="90" />
             <source>Output CRS</source>
             <translation>Ausgabe-KBS</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="107" />
+            <location filename="../processing/algorithms/orientimages.py" line="94" />
             <source>Working resolution (max image side, px)</source>
             <translation>Arbeitsauflösung (größte Bildseite, px)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="117" />
+            <location filename="../processing/algorithms/orientimages.py" line="104" />
             <source>Features per image</source>
             <translation>Merkmale pro Bild</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="125" />
+            <location filename="../processing/algorithms/orientimages.py" line="112" />
             <source>Self-calibration</source>
             <translation>Selbstkalibrierung</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="133" />
+            <location filename="../processing/algorithms/orientimages.py" line="120" />
             <source>Report (HTML)</source>
             <translation>Bericht (HTML)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="133" />
+            <location filename="../processing/algorithms/orientimages.py" line="120" />
             <source>HTML files (*.html)</source>
             <translation>HTML-Dateien (*.html)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="140" />
+            <location filename="../processing/algorithms/orientimages.py" line="127" />
             <source>Tie points</source>
             <translation>Verknüpfungspunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="146" />
+            <location filename="../processing/algorithms/orientimages.py" line="133" />
             <source>GCP and check point residuals</source>
             <translation>Residuen der Pass- und Kontrollpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="159" />
+            <location filename="../processing/algorithms/orientimages.py" line="146" />
             <source>Give either IMAGES (a folder) or IMAGE_FILES, not both</source>
             <translation>Geben Sie entweder IMAGES (einen Ordner) oder IMAGE_FILES an, nicht beides</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="169" />
+            <location filename="../processing/algorithms/orientimages.py" line="156" />
             <source>IMAGES: give an image folder or a list of image files</source>
             <translation>IMAGES: geben Sie einen Bildordner oder eine Liste von Bilddateien an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="181" />
-            <source>GCPS and OBSERVATIONS must be given together</source>
-            <translation>GCPS und OBSERVATIONS müssen zusammen angegeben werden</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/orientimages.py" line="217" />
+            <location filename="../processing/algorithms/orientimages.py" line="197" />
             <source>Registered {} of {} images; sigma0 {:.3f} px</source>
             <translation>{} von {} Bildern orientiert; Sigma0 {:.3f} px</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="190" />
+            <location filename="../processing/algorithms/orientimages.py" line="170" />
             <source>{} control and {} check points</source>
             <translation>{} Pass- und {} Kontrollpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="162" />
+            <location filename="../processing/algorithms/orientimages.py" line="149" />
             <source>IMAGES: {} is not a folder</source>
             <translation>IMAGES: {} ist kein Ordner</translation>
         </message>
@@ -724,77 +719,77 @@
             <translation>Z_SURFACE: Rasterdatei (GeoTIFF) erwartet, erhalten: {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="30" />
+            <location filename="../processing/algorithms/pipeline.py" line="29" />
             <source>Photos to true orthophoto (whole pipeline)</source>
             <translation>Fotos zum True Orthophoto (gesamte Prozesskette)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="97" />
+            <location filename="../processing/algorithms/pipeline.py" line="84" />
             <source>DSM (filtered)</source>
             <translation>DOM (gefiltert)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="100" />
+            <location filename="../processing/algorithms/pipeline.py" line="87" />
             <source>True orthophoto</source>
             <translation>True Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="101" />
+            <location filename="../processing/algorithms/pipeline.py" line="88" />
             <source>Occlusion mask</source>
             <translation>Verdeckungsmaske</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="102" />
+            <location filename="../processing/algorithms/pipeline.py" line="89" />
             <source>Seamlines</source>
             <translation>Nahtlinien</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="82" />
+            <location filename="../processing/algorithms/pipeline.py" line="69" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Auflösung des DOM und des True Orthophotos (m, 0 = Bodenpixelgröße)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="90" />
+            <location filename="../processing/algorithms/pipeline.py" line="77" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Eine vorhandene orientation.json im Ausgabeordner wiederverwenden</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="117" />
+            <location filename="../processing/algorithms/pipeline.py" line="104" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES: geben Sie den Ordner der Fotos an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="132" />
+            <location filename="../processing/algorithms/pipeline.py" line="119" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER: geben Sie einen Ordner für die Produkte an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="149" />
+            <location filename="../processing/algorithms/pipeline.py" line="129" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION: positive Anzahl Meter oder 0 erwartet</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="178" />
+            <location filename="../processing/algorithms/pipeline.py" line="158" />
             <source>DSM (TruOrtho)</source>
             <translation>DOM (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="179" />
+            <location filename="../processing/algorithms/pipeline.py" line="159" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>True Orthophoto (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="180" />
+            <location filename="../processing/algorithms/pipeline.py" line="160" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Verdeckung (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="181" />
+            <location filename="../processing/algorithms/pipeline.py" line="161" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Nahtlinien (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="164" />
+            <location filename="../processing/algorithms/pipeline.py" line="144" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{}: {:.1f} s, Spitze {:.0f} MB; {}</translation>
         </message>
@@ -1642,6 +1637,11 @@
             <location filename="../processing/layers.py" line="307" />
             <source>Observation</source>
             <translation>Beobachtung</translation>
+        </message>
+        <message>
+            <location filename="../processing/layers.py" line="344" />
+            <source>GCPS and OBSERVATIONS must be given together</source>
+            <translation>GCPS und OBSERVATIONS müssen zusammen angegeben werden</translation>
         </message>
         <message>
             <location filename="../processing/layers.py" line="51" />

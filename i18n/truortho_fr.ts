@@ -24,6 +24,16 @@
             <translation>Outils</translation>
         </message>
         <message>
+            <location filename="../processing/algorithms/base.py" line="57" />
+            <source>Ground control points</source>
+            <translation>Points d'appui</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/base.py" line="63" />
+            <source>GCP image measurements (table)</source>
+            <translation>Mesures image des points d'appui (table)</translation>
+        </message>
+        <message>
             <location filename="../processing/algorithms/dsmfilter.py" line="31" />
             <source>Filter DSM (outliers, holes, smoothing, DTM)</source>
             <translation>Filtrer le MNS (valeurs aberrantes, trous, lissage, MNT)</translation>
@@ -269,11 +279,6 @@
             <translation>Reprojeter dans le SCR</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="65" />
-            <source>Ground control points</source>
-            <translation>Points d'appui</translation>
-        </message>
-        <message>
             <location filename="../processing/algorithms/importgcps.py" line="70" />
             <source>GCP image measurements</source>
             <translation>Mesures image des points d'appui</translation>
@@ -289,87 +294,82 @@
             <translation>CHECK_POINTS : nom(s) de point d'appui inconnu(s) {} ; le fichier contient {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="45" />
+            <location filename="../processing/algorithms/importorientation.py" line="44" />
             <source>Import orientation</source>
             <translation>Importer une orientation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="61" />
+            <location filename="../processing/algorithms/importorientation.py" line="60" />
             <source>Orientation file (COLMAP, Orthority CSV, OpenSfM)</source>
             <translation>Fichier d'orientation (COLMAP, CSV Orthority, OpenSfM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="65" />
+            <location filename="../processing/algorithms/importorientation.py" line="64" />
             <source>Interior parameter file (Orthority)</source>
             <translation>Fichier des paramètres internes (Orthority)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="70" />
+            <location filename="../processing/algorithms/importorientation.py" line="69" />
             <source>CRS of the input (when the file has none)</source>
             <translation>SCR de l'entrée (si le fichier n'en indique pas)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="76" />
+            <location filename="../processing/algorithms/importorientation.py" line="75" />
             <source>Image folder</source>
             <translation>Dossier des images</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="89" />
-            <source>GCP image measurements (table)</source>
-            <translation>Mesures image des points d'appui (table)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/importorientation.py" line="97" />
+            <location filename="../processing/algorithms/importorientation.py" line="84" />
             <source>Footprint height</source>
             <translation>Hauteur des emprises</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="104" />
+            <location filename="../processing/algorithms/importorientation.py" line="91" />
             <source>Orientation (JSON)</source>
             <translation>Orientation (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="108" />
+            <location filename="../processing/algorithms/importorientation.py" line="95" />
             <source>Cameras</source>
             <translation>Caméras</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="112" />
+            <location filename="../processing/algorithms/importorientation.py" line="99" />
             <source>Footprints</source>
             <translation>Emprises des images</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="138" />
+            <location filename="../processing/algorithms/importorientation.py" line="125" />
             <source>The orientation has no CRS: it stays in its arbitrary (local) frame. Give CRS (or a georef.json) to georeference it.</source>
             <translation>L'orientation n'a pas de SCR : elle reste dans son repère arbitraire (local). Indiquez CRS (ou un georef.json) pour la géoréférencer.</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="154" />
+            <location filename="../processing/algorithms/importorientation.py" line="141" />
             <source>OBSERVATIONS given without a GCPS layer</source>
             <translation>OBSERVATIONS fourni sans couche GCPS</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="128" />
+            <location filename="../processing/algorithms/importorientation.py" line="115" />
             <source>Read {} images, {} cameras, {} sparse points</source>
             <translation>{} images, {} caméras, {} points épars lus</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="158" />
+            <location filename="../processing/algorithms/importorientation.py" line="145" />
             <source>GCPs need a georeferenced orientation: give CRS for the input</source>
             <translation>Les points d'appui exigent une orientation géoréférencée : indiquez CRS pour l'entrée</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="135" />
+            <location filename="../processing/algorithms/importorientation.py" line="122" />
             <source>{}: the orientation contains no images</source>
             <translation>{} : l'orientation ne contient aucune image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="164" />
+            <location filename="../processing/algorithms/importorientation.py" line="151" />
             <source>{} GCPs with {} image measurements</source>
             <translation>{} points d'appui avec {} mesures image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="200" />
+            <location filename="../processing/algorithms/importorientation.py" line="187" />
             <source>Image {} does not see the plane at height {}</source>
             <translation>L'image {} ne voit pas le plan à la hauteur {}</translation>
         </message>
@@ -479,87 +479,82 @@
             <translation>{} cellules -&gt; {} sommets ({:.1%} des cellules), {} faces dont {} faces de mur ; seuil de saut {:.2f} m, erreur verticale &lt;= {:.3f} m</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="55" />
+            <location filename="../processing/algorithms/orientimages.py" line="54" />
             <source>Orient images (bundle block adjustment)</source>
             <translation>Orienter les images (compensation par faisceaux)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="82" />
+            <location filename="../processing/algorithms/orientimages.py" line="81" />
             <source>Image files (instead of a folder)</source>
             <translation>Fichiers image (au lieu d'un dossier)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="88" />
+            <location filename="../processing/algorithms/orientimages.py" line="87" />
             <source>Interior orientation file (optional)</source>
             <translation>Fichier d'orientation interne (facultatif)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="103" />
+            <location filename="../processing/algorithms/orientimages.py" line="90" />
             <source>Output CRS</source>
             <translation>SCR de sortie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="107" />
+            <location filename="../processing/algorithms/orientimages.py" line="94" />
             <source>Working resolution (max image side, px)</source>
             <translation>Résolution de travail (plus grand côté de l'image, px)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="117" />
+            <location filename="../processing/algorithms/orientimages.py" line="104" />
             <source>Features per image</source>
             <translation>Points caractéristiques par image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="125" />
+            <location filename="../processing/algorithms/orientimages.py" line="112" />
             <source>Self-calibration</source>
             <translation>Autocalibration</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="133" />
+            <location filename="../processing/algorithms/orientimages.py" line="120" />
             <source>Report (HTML)</source>
             <translation>Rapport (HTML)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="133" />
+            <location filename="../processing/algorithms/orientimages.py" line="120" />
             <source>HTML files (*.html)</source>
             <translation>Fichiers HTML (*.html)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="140" />
+            <location filename="../processing/algorithms/orientimages.py" line="127" />
             <source>Tie points</source>
             <translation>Points de liaison</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="146" />
+            <location filename="../processing/algorithms/orientimages.py" line="133" />
             <source>GCP and check point residuals</source>
             <translation>Résidus des points d'appui et de contrôle</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="159" />
+            <location filename="../processing/algorithms/orientimages.py" line="146" />
             <source>Give either IMAGES (a folder) or IMAGE_FILES, not both</source>
             <translation>Indiquez soit IMAGES (un dossier), soit IMAGE_FILES, pas les deux</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="169" />
+            <location filename="../processing/algorithms/orientimages.py" line="156" />
             <source>IMAGES: give an image folder or a list of image files</source>
             <translation>IMAGES : indiquez un dossier d'images ou une liste de fichiers image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="181" />
-            <source>GCPS and OBSERVATIONS must be given together</source>
-            <translation>GCPS et OBSERVATIONS doivent être fournis ensemble</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/orientimages.py" line="217" />
+            <location filename="../processing/algorithms/orientimages.py" line="197" />
             <source>Registered {} of {} images; sigma0 {:.3f} px</source>
             <translation>{} images sur {} orientées ; sigma0 {:.3f} px</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="190" />
+            <location filename="../processing/algorithms/orientimages.py" line="170" />
             <source>{} control and {} check points</source>
             <translation>{} points d'appui et {} points de contrôle</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="162" />
+            <location filename="../processing/algorithms/orientimages.py" line="149" />
             <source>IMAGES: {} is not a folder</source>
             <translation>IMAGES : {} n'est pas un dossier</translation>
         </message>
@@ -724,77 +719,77 @@
             <translation>Z_SURFACE : fichier raster (GeoTIFF) attendu, reçu {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="30" />
+            <location filename="../processing/algorithms/pipeline.py" line="29" />
             <source>Photos to true orthophoto (whole pipeline)</source>
             <translation>Des photos à l'orthophoto vraie (chaîne complète)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="97" />
+            <location filename="../processing/algorithms/pipeline.py" line="84" />
             <source>DSM (filtered)</source>
             <translation>MNS (filtré)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="100" />
+            <location filename="../processing/algorithms/pipeline.py" line="87" />
             <source>True orthophoto</source>
             <translation>Orthophoto vraie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="101" />
+            <location filename="../processing/algorithms/pipeline.py" line="88" />
             <source>Occlusion mask</source>
             <translation>Masque d'occultation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="102" />
+            <location filename="../processing/algorithms/pipeline.py" line="89" />
             <source>Seamlines</source>
             <translation>Lignes de raccord</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="82" />
+            <location filename="../processing/algorithms/pipeline.py" line="69" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Résolution du MNS et de l'orthophoto vraie (m, 0 = taille du pixel au sol)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="90" />
+            <location filename="../processing/algorithms/pipeline.py" line="77" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Réutiliser un orientation.json existant dans le dossier de sortie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="117" />
+            <location filename="../processing/algorithms/pipeline.py" line="104" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES : indiquez le dossier des photos</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="132" />
+            <location filename="../processing/algorithms/pipeline.py" line="119" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER : indiquez un dossier pour les produits</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="149" />
+            <location filename="../processing/algorithms/pipeline.py" line="129" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION : nombre positif de mètres ou 0 attendu</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="178" />
+            <location filename="../processing/algorithms/pipeline.py" line="158" />
             <source>DSM (TruOrtho)</source>
             <translation>MNS (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="179" />
+            <location filename="../processing/algorithms/pipeline.py" line="159" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>Orthophoto vraie (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="180" />
+            <location filename="../processing/algorithms/pipeline.py" line="160" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Occultation (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="181" />
+            <location filename="../processing/algorithms/pipeline.py" line="161" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Lignes de raccord (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="164" />
+            <location filename="../processing/algorithms/pipeline.py" line="144" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{} : {:.1f} s, pic {:.0f} Mo ; {}</translation>
         </message>
@@ -1642,6 +1637,11 @@
             <location filename="../processing/layers.py" line="307" />
             <source>Observation</source>
             <translation>Observation</translation>
+        </message>
+        <message>
+            <location filename="../processing/layers.py" line="344" />
+            <source>GCPS and OBSERVATIONS must be given together</source>
+            <translation>GCPS et OBSERVATIONS doivent être fournis ensemble</translation>
         </message>
         <message>
             <location filename="../processing/layers.py" line="51" />

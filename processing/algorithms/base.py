@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from qgis.core import QgsProcessingAlgorithm
+from qgis.core import QgsProcessing, QgsProcessingAlgorithm, QgsProcessingParameterVectorLayer
 
 from ..help import help_html, parameter_help
 from ..i18n import tr
@@ -49,3 +49,19 @@ class TruOrthoAlgorithm(QgsProcessingAlgorithm):
             param.setFlags(param.flags() | param.FlagAdvanced)
         self.addParameter(param)
         return param
+
+    def add_ground_control(self) -> None:
+        """The optional GCPS point layer and OBSERVATIONS table (schema in docs/FORMATS.md)."""
+        self.add(
+            QgsProcessingParameterVectorLayer(
+                "GCPS", tr("Ground control points"), [QgsProcessing.TypeVectorPoint], optional=True
+            )
+        )
+        self.add(
+            QgsProcessingParameterVectorLayer(
+                "OBSERVATIONS",
+                tr("GCP image measurements (table)"),
+                [QgsProcessing.TypeVector],
+                optional=True,
+            )
+        )

@@ -12,7 +12,6 @@ from qgis.core import (
     QgsProcessingParameterFile,
     QgsProcessingParameterFileDestination,
     QgsProcessingParameterNumber,
-    QgsProcessingParameterVectorLayer,
     QgsWkbTypes,
 )
 
@@ -78,19 +77,7 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
                 optional=True,
             )
         )
-        self.add(
-            QgsProcessingParameterVectorLayer(
-                self.GCPS, tr("Ground control points"), [QgsProcessing.TypeVectorPoint], optional=True
-            )
-        )
-        self.add(
-            QgsProcessingParameterVectorLayer(
-                self.OBSERVATIONS,
-                tr("GCP image measurements (table)"),
-                [QgsProcessing.TypeVector],
-                optional=True,
-            )
-        )
+        self.add_ground_control()
         self.add(
             QgsProcessingParameterNumber(
                 self.FOOTPRINT_HEIGHT,

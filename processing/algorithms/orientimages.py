@@ -20,7 +20,6 @@ from qgis.core import (
     QgsProcessingParameterFileDestination,
     QgsProcessingParameterMultipleLayers,
     QgsProcessingParameterNumber,
-    QgsProcessingParameterVectorLayer,
     QgsWkbTypes,
 )
 from qgis.PyQt.QtCore import QVariant
@@ -87,19 +86,7 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
         self.add(
             QgsProcessingParameterFile(self.CAMERA, tr("Interior orientation file (optional)"), optional=True)
         )
-        self.add(
-            QgsProcessingParameterVectorLayer(
-                self.GCPS, tr("Ground control points"), [QgsProcessing.TypeVectorPoint], optional=True
-            )
-        )
-        self.add(
-            QgsProcessingParameterVectorLayer(
-                self.OBSERVATIONS,
-                tr("GCP image measurements (table)"),
-                [QgsProcessing.TypeVector],
-                optional=True,
-            )
-        )
+        self.add_ground_control()
         self.add(QgsProcessingParameterCrs(self.CRS, tr("Output CRS"), optional=True))
         self.add(
             QgsProcessingParameterNumber(

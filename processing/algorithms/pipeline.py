@@ -16,7 +16,6 @@ from qgis.core import (
     QgsProcessingParameterFile,
     QgsProcessingParameterFolderDestination,
     QgsProcessingParameterNumber,
-    QgsProcessingParameterVectorLayer,
 )
 
 from ..feedback import FeedbackProgress, core_errors
@@ -62,19 +61,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
             ),
             advanced=True,
         )
-        self.add(
-            QgsProcessingParameterVectorLayer(
-                self.GCPS, tr("Ground control points"), [QgsProcessing.TypeVectorPoint], optional=True
-            )
-        )
-        self.add(
-            QgsProcessingParameterVectorLayer(
-                self.OBSERVATIONS,
-                tr("GCP image measurements (table)"),
-                [QgsProcessing.TypeVector],
-                optional=True,
-            )
-        )
+        self.add_ground_control()
         self.add(QgsProcessingParameterCrs(self.CRS, tr("Output CRS"), optional=True))
         self.add(
             QgsProcessingParameterNumber(
