@@ -302,3 +302,28 @@ def to_uint8(img: np.ndarray) -> np.ndarray:
     if not hi > lo:
         hi = lo + 1.0
     return np.clip((f - lo) * (255.0 / (hi - lo)) + 0.5, 0, 255).astype(np.uint8)
+
+
+def check_image_size(path, size) -> ImageInfo:
+    """The header of an image whose camera expects ``size = (width, height)``; FormatError otherwise."""
+    info = image_info(path)
+    w, h = (int(v) for v in size)
+    if (info.width, info.height) != (w, h):
+        raise FormatError(
+            info.path, f"image is {info.width} x {info.height} pixels but its camera says {w} x {h}"
+        )
+    return info
+
+
+def read_image_sized(path, size) -> np.ndarray:
+    """:func:`read_image` of an image whose camera expects ``size = (width, height)``.
+
+    Raises FormatError naming the file when the sizes differ.
+    """
+    img = read_image(path)
+    w, h = (int(v) for v in size)
+    if img.shape[:2] != (h, w):
+        raise FormatError(
+            str(path), f"image is {img.shape[1]} x {img.shape[0]} pixels but its camera says {w} x {h}"
+        )
+    return img

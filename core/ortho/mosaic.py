@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FormatError, InputError
-from ..imagery import read_image
+from ..imagery import read_image_sized
 from .color import ColorCorrection, value_scale
 from .seams import feather_weights
 from .select import data_costs, select_labels
@@ -49,14 +49,8 @@ class ImageStore:
             self._cache.move_to_end(key)
             return self._cache[key]
         if level == 0:
-            img = read_image(self.paths[i])
+            img = read_image_sized(self.paths[i], self.sizes[i])
             self.reads += 1
-            w, h = self.sizes[i]
-            if img.shape[:2] != (h, w):
-                raise FormatError(
-                    self.paths[i],
-                    f"image is {img.shape[1]} x {img.shape[0]} pixels but its camera says {w} x {h}",
-                )
             nb = 1 if img.ndim == 2 else img.shape[2]
             if nb != self.bands or img.dtype != self.dtype:
                 raise FormatError(

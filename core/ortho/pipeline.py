@@ -177,10 +177,6 @@ class TrueOrthoResult:
     stats: dict = field(default_factory=dict)
 
 
-def _load_orientation(orientation) -> Orientation:
-    return as_orientation(orientation)
-
-
 def _default_resolution(surface, orientation: Orientation, out_crs) -> float:
     """The DSM's cell size when it is in the output CRS, else the median nadir GSD."""
     same = surface.crs is None or out_crs is None or same_crs(surface.crs, out_crs)
@@ -242,7 +238,7 @@ def true_ortho(
     cfg.validate()
     steps = Steps(progress, [1, 3 if cfg.color_correction else 0, 12, 1])
     prog = as_progress(progress)
-    o = _load_orientation(orientation)
+    o = as_orientation(orientation)
     if not o.images:
         raise InputError("ORIENTATION: the orientation holds no image")
     if len(o.images) > 32767 and source_index is not None:

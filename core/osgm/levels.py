@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..grid import RasterGrid
 
 #: Z steps the coarsest level may need for the whole range.
@@ -67,6 +68,11 @@ class LevelPlan:
 
 
 def plan_levels(z_min: float, z_max: float, dz: float, grid: RasterGrid, max_levels: int = 5) -> LevelPlan:
+    """The pyramid levels (coarse to fine) for the Z range ``[z_min, z_max]`` searched in steps ``dz``."""
+    if not (math.isfinite(z_min) and math.isfinite(z_max) and z_max > z_min):
+        raise InputError(f"Z range: expected finite z_min < z_max, got {z_min!r} .. {z_max!r}")
+    if not (math.isfinite(dz) and dz > 0):
+        raise InputError(f"Z_STEP: expected a positive number, got {dz!r}")
     n = (z_max - z_min) / dz
     need = max(0, math.ceil(math.log2(max(n / COARSE_LEVELS, 1.0))))
     top = max(need, 2)

@@ -28,6 +28,7 @@ import dataclasses
 import math
 import os
 import time
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -278,6 +279,8 @@ def _axis_rotation(direction) -> np.ndarray:
 
 def reference_systems(orientation: Orientation, mode: str, group_angle: float) -> list[RefSystem]:
     """The nadir system, plus one per group of oblique images when ``mode == "auto"``."""
+    if mode not in ("none", "auto"):
+        raise InputError(f"OBLIQUE: expected 'none' or 'auto', got {mode!r}")
     dirs = np.array([im.R[2] for im in orientation.images])  # optical axes in the world
     tilt = np.degrees(np.arccos(np.clip(-dirs[:, 2], -1, 1)))
     systems = [RefSystem(0, "nadir", np.eye(3), np.array([0.0, 0.0, -1.0]), list(range(len(dirs))))]
@@ -316,10 +319,6 @@ def _system_views(orientation: Orientation, system: RefSystem) -> list[View]:
 
 
 # ------------------------------------------------------------------ defaults from the block
-
-
-def _load(orientation) -> Orientation:
-    return as_orientation(orientation)
 
 
 def _known_heights(o: Orientation) -> np.ndarray:
@@ -532,7 +531,7 @@ def _match_system(
         prev_z = z
         prev_filled = _fill_nearest(z)
     assert prev_z is not None
-    rgb = _colours(views, pyr, grid, prev_z, cfg) if want_colour else None
+    rgb = _colours(views, pyr, grid, prev_z, cfg, progress) if want_colour else None
     return SystemResult(grid, prev_z, conf, rgb, plan, n_tiles, max_volume)
 
 
@@ -558,7 +557,7 @@ def _interpolate(coarse: np.ndarray, window) -> np.ndarray:
     return map_coordinates(coarse, [R, C], order=1, mode="nearest").astype(np.float32)
 
 
-def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig) -> np.ndarray:
+def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig, progress: Progress) -> np.ndarray:
     """Colour of the best visible image per cell (uint8 RGB, 0 where none).
 
     Per tile, every image that sees it is sampled at the matched surface; an
@@ -571,6 +570,8 @@ def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig) -> np
     params.max_images = len(views)  # every image that sees the tile, on both sides of a tile border
     out = np.zeros(grid.shape + (3,), np.uint8)
     for tile in grid.tiles(int(cfg.tile_size), 0):
+        if progress.cancelled():
+            raise CancelledError("OSGM cancelled")
         r0, c0, nr, nc = tile.outer
         zt = z[r0 : r0 + nr, c0 : c0 + nc]
         ok = np.isfinite(zt)
@@ -584,8 +585,6 @@ def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig) -> np
         col = sample_surface(imgs, tx0, ty0, grid.res, zt)  # (n, rows, cols, 3)
         scale = np.array([pyr.value_max(im.view.index) for im in imgs])
         lum = (col[..., 0] * 0.299 + col[..., 1] * 0.587 + col[..., 2] * 0.114) / scale[:, None, None]
-        import warnings
-
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", RuntimeWarning)
             med = np.nanmedian(lum, axis=0)
@@ -657,7 +656,7 @@ def run_osgm(
     if outputs is None:
         raise InputError("DSM: an output path is required")
     outputs.validate()
-    o = _load(orientation)
+    o = as_orientation(orientation)
     o.validate()
     if o.crs is None:
         raise InputError("ORIENTATION: the orientation has no CRS; georeference it first")
@@ -818,7 +817,6 @@ def _run_systems(
 
 def _check_overlap(o: Orientation, grid: RasterGrid, ground: float) -> None:
     """The extent must meet the area the images see (clear error instead of an empty DSM)."""
-    off = o.offset
     x0, y0, x1, y1 = grid.extent
     try:
         bx0, by0, bx1, by1 = default_extent(o, ground)
@@ -829,7 +827,6 @@ def _check_overlap(o: Orientation, grid: RasterGrid, ground: float) -> None:
             f"EXTENT: ({x0:.2f}, {y0:.2f}, {x1:.2f}, {y1:.2f}) does not intersect the area the images see "
             f"({bx0:.2f}, {by0:.2f}, {bx1:.2f}, {by1:.2f}) in {o.crs}"
         )
-    del off
 
 
 def _surface_range(path, o: Orientation, cfg: OsgmConfig, extent) -> tuple[float, float, str]:
@@ -879,9 +876,7 @@ def _oblique_points(
     res = local.res
     sgrid = RasterGrid.from_extent((s_lo[0], s_lo[1], s_hi[0], s_hi[1]), res, None)
     plan = plan_levels(float(s_lo[2]), float(s_hi[2]), dz, sgrid, cfg.max_levels)
-    r = _match_system(
-        o, system, pyr, sgrid, plan, cfg, progress, None, want_rgb, executor, cache, cache_base
-    )
+    r = _match_system(o, system, pyr, sgrid, plan, cfg, progress, None, want_rgb, executor, cache, cache_base)
     ok = np.isfinite(r.z)
     X, Y = sgrid.centres()
     S = np.column_stack([X[ok], Y[ok], r.z[ok].astype(np.float64)])
@@ -899,7 +894,6 @@ def _write_outputs(o, grid, dsm, conf, rgb, clouds, systems, outputs: OsgmOutput
 
     written = {}
     nod = np.where(np.isfinite(dsm), dsm, DSM_NODATA).astype(np.float32)
-    tmp_ortho = None
     write_raster(outputs.dsm, nod, grid, nodata=DSM_NODATA, overviews=True, descriptions=["height"])
     written["dsm"] = str(outputs.dsm)
     if outputs.confidence is not None:
@@ -947,5 +941,4 @@ def _write_outputs(o, grid, dsm, conf, rgb, clouds, systems, outputs: OsgmOutput
         cloud.systems = refs
         write_point_cloud_file(outputs.point_cloud, cloud)
         written["point_cloud"] = str(outputs.point_cloud)
-    del tmp_ortho, res
     return written

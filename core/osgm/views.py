@@ -21,13 +21,14 @@ decoded once and kept in a least-recently-used cache bounded in bytes.
 from __future__ import annotations
 
 import math
+import warnings
 from collections import OrderedDict
 
 import numpy as np
 
 from ..errors import InputError
 from ..geometry.camera import Camera, _distort_one
-from ..imagery import _read_rasterio, _use_rasterio, image_info, luminance, read_image
+from ..imagery import _read_rasterio, _use_rasterio, check_image_size, image_info, luminance, read_image_sized
 from ..jit import njit
 
 
@@ -174,16 +175,8 @@ class ImagePyramid:
             self._cache.move_to_end(key)
             return self._cache[key]
         if level == 0:
-            img = read_image(self.paths[i])
+            img = read_image_sized(self.paths[i], self.sizes[i])
             self.reads += 1
-            w, h = self.sizes[i]
-            if img.shape[:2] != (h, w):
-                from ..errors import FormatError
-
-                raise FormatError(
-                    self.paths[i],
-                    f"image is {img.shape[1]} x {img.shape[0]} pixels but its camera says {w} x {h}",
-                )
             out = self._convert(img, colour)
         else:
             import cv2
@@ -259,8 +252,6 @@ class ImagePyramid:
         return out[:h, :w]
 
     def _read_decimated(self, i, win, shape):
-        import warnings
-
         import rasterio
         from rasterio.enums import Resampling
         from rasterio.windows import Window
@@ -278,11 +269,5 @@ class ImagePyramid:
 
 def check_images(paths, sizes) -> None:
     """Every image exists, is readable and has its camera's size (before anything is written)."""
-    from ..errors import FormatError
-
-    for p, (w, h) in zip(paths, sizes, strict=True):
-        info = image_info(p)
-        if (info.width, info.height) != (w, h):
-            raise FormatError(
-                p, f"image is {info.width} x {info.height} pixels but its camera says {w} x {h}"
-            )
+    for p, size in zip(paths, sizes, strict=True):
+        check_image_size(p, size)

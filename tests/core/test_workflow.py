@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from truortho.core.errors import InputError
+from truortho.core.progress import CallbackProgress
 from truortho.core.rasterio_io import read_raster
 from truortho.core.synthetic import SceneConfig, make_scene
 from truortho.core.workflow import PRODUCTS, WorkflowConfig, run_workflow
@@ -30,9 +31,7 @@ def test_workflow_products_and_report_from_a_reused_orientation(tmp_path):
     fractions = []
     r = run_workflow(
         [], out, config=WorkflowConfig(resolution=res, reuse_orientation=True),
-        progress=__import__("truortho.core.progress", fromlist=["CallbackProgress"]).CallbackProgress(
-            lambda f, m: fractions.append(f)
-        ),
+        progress=CallbackProgress(lambda f, m: fractions.append(f)),
     )  # fmt: skip
     for key, name in PRODUCTS.items():
         assert (out / name).exists(), key
