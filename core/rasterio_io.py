@@ -169,6 +169,10 @@ class RasterWriter:
             self.profile["compress"] = compress
             if compress.lower() in ("deflate", "lzw", "zstd"):
                 self.profile["predictor"] = 3 if self.dtype.kind == "f" else 2
+            self.profile["num_threads"] = "ALL_CPUS"  # GDAL compresses blocks in threads
+            if cog and compress.lower() == "deflate":
+                # the temporary file is read once by the COG copy, which compresses again: fast level
+                self.profile["zlevel"] = 1
         if photometric is None and self.dtype == np.uint8 and bands in (3, 4):
             photometric = "RGB"
         if photometric:
@@ -265,6 +269,8 @@ class RasterWriter:
         }
         if "predictor" in self.profile:
             opts["predictor"] = "YES"
+        if "num_threads" in self.profile:
+            opts["num_threads"] = "ALL_CPUS"
         try:
             rio_copy(self._tmp, cog_tmp, driver="COG", **opts)
             os.replace(cog_tmp, self._tmp)

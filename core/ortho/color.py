@@ -37,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
+from ..jit import njit
 
 _M = np.array(
     [[0.4124564, 0.3575761, 0.1804375], [0.2126729, 0.7151522, 0.0721750], [0.0193339, 0.1191920, 0.9503041]]
@@ -237,15 +238,33 @@ def estimate_corrections(
     return ColorCorrection(gain, offset, uses_lab(nch), stats)
 
 
-def _robust_moments(x: np.ndarray, inverse: np.ndarray, k: int):
-    """Per group: median and robust spread (half the 16-84 % interpercentile range)."""
-    order = np.lexsort((x, inverse))
-    xs, gs = x[order], inverse[order]
-    starts = np.searchsorted(gs, np.arange(k))
-    ends = np.searchsorted(gs, np.arange(k), side="right")
-    n = ends - starts
-    pick = lambda q: xs[np.minimum(starts + np.floor(q * (n - 1)).astype(np.int64), ends - 1)]  # noqa: E731
-    return pick(0.5), 0.5 * (pick(0.8413) - pick(0.1587))
+def _robust_moments(x: np.ndarray, inverse: np.ndarray, k: int, order: np.ndarray | None = None):
+    """Per group: median and robust spread (half the 16-84 % interpercentile range).
+
+    ``order`` (optional, reused across calls): ``argsort(inverse, kind="stable")``.
+    """
+    if order is None:
+        order = np.argsort(inverse, kind="stable")
+    n = np.bincount(inverse, minlength=k).astype(np.int64)
+    starts = np.zeros(k, np.int64)
+    starts[1:] = np.cumsum(n)[:-1]
+    out = np.zeros((k, 3))
+    xs = np.ascontiguousarray(np.asarray(x, np.float64)[order])
+    _group_percentiles(xs, starts, n, np.array([0.5, 0.1587, 0.8413]), out)
+    return out[:, 0], 0.5 * (out[:, 2] - out[:, 1])
+
+
+@njit
+def _group_percentiles(xs, starts, n, qs, out):
+    """``out[g, j]``: the value of rank ``floor(qs[j] (n_g - 1))`` of group g (values grouped in xs)."""
+    for g in range(len(starts)):
+        m = n[g]
+        if m <= 0:
+            continue
+        v = xs[starts[g] : starts[g] + m].copy()
+        for j in range(len(qs)):
+            r = min(int(np.floor(qs[j] * (m - 1))), m - 1)
+            out[g, j] = np.partition(v, r)[r]
 
 
 def _moment_match(upairs, inverse, counts, xa, xb, n, prior, huber, iterations, min_pair):
@@ -265,8 +284,9 @@ def _moment_match(upairs, inverse, counts, xa, xb, n, prior, huber, iterations, 
     connected images towards zero and push the others up to keep the mean.
     """
     k = len(upairs)
-    _, sa = _robust_moments(xa, inverse, k)
-    _, sb = _robust_moments(xb, inverse, k)
+    order = np.argsort(inverse, kind="stable")
+    _, sa = _robust_moments(xa, inverse, k, order)
+    _, sb = _robust_moments(xb, inverse, k, order)
     ok = (counts >= min_pair) & (sa > 1e-9) & (sb > 1e-9)
     a_img, b_img = upairs // n, upairs % n
     w0 = np.sqrt(counts.astype(np.float64))
@@ -279,7 +299,7 @@ def _moment_match(upairs, inverse, counts, xa, xb, n, prior, huber, iterations, 
     g /= g.mean()  # the block's level: mean gain 1 (the ratios are what the pairs determine)
     # offsets: given the gains, the median of the paired differences of the cells (content cancels)
     pa, pb = upairs[inverse] // n, upairs[inverse] % n
-    dmed, _ = _robust_moments(g[pb] * xb - g[pa] * xa, inverse, k)
+    dmed, _ = _robust_moments(g[pb] * xb - g[pa] * xa, inverse, k, order)
     scale = float(np.median(np.concatenate([sa[ok], sb[ok]])))
     o = _pair_solve(a_img[ok], b_img[ok], dmed[ok], w0[ok], n, prior, huber, iterations, scale)
     return g, o

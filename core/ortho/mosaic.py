@@ -22,6 +22,7 @@ import numpy as np
 
 from ..errors import FormatError, InputError
 from ..imagery import read_image_sized
+from ..jit import njit
 from .color import ColorCorrection, value_scale
 from .seams import feather_weights
 from .select import data_costs, select_labels
@@ -119,6 +120,17 @@ def sample(img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, in
     return np.concatenate(outs, axis=2) if len(outs) > 1 else outs[0]
 
 
+def sample_points(img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, int]) -> np.ndarray:
+    """:func:`sample` of ``(n, 2)`` points: ``(n, bands)`` float32 (OpenCV maps are at most 32767 wide)."""
+    n = len(uv)
+    width = 1024
+    rows = max(1, -(-n // width))
+    pad = np.full((rows * width, 2), np.nan, np.float32)
+    pad[:n] = uv
+    out = sample(img, pad.reshape(rows, width, 2), level, full_size)
+    return out.reshape(rows * width, -1)[:n]
+
+
 def luminance01(col: np.ndarray, dtype) -> np.ndarray:
     """Luminance in [0, 1]-ish units of samples (..., bands) float32 (Rec. 601 for RGB, band 1 otherwise)."""
     s = value_scale(dtype)
@@ -176,12 +188,36 @@ def candidate_colours(
         i = int(views.cands[k])
         level = store.level_for(float(views.gsd[k]), res)
         img = store.get(i, level)
+        if m.sum() * 4 < m.size:  # few cells (a late candidate): sample only those
+            col = sample_points(img, views.uv[k][m], level, store.sizes[i])
+            if correction is not None and not correction.is_identity(i):
+                col = correction.apply(i, col, store.dtype).astype(np.float32)
+            out[k][m] = col
+            continue
         col = sample(img, views.uv[k], level, store.sizes[i])
-        vals = col[m]
         if correction is not None and not correction.is_identity(i):
-            vals = correction.apply(i, vals, store.dtype).astype(np.float32)
-        out[k][m] = vals
+            out[k][m] = correction.apply(i, col[m], store.dtype).astype(np.float32)
+        else:
+            np.copyto(out[k], col, where=m[..., None])
     return out
+
+
+@njit
+def _blend(w, colours, out):
+    """``out[b, r, c] = sum_k w[k, r, c] colours[k, r, c, b]`` over the k with a positive weight."""
+    K, rows, cols = w.shape
+    B = colours.shape[3]
+    for r in range(rows):
+        for c in range(cols):
+            for b in range(B):
+                out[b, r, c] = 0.0
+            for k in range(K):
+                wk = w[k, r, c]
+                if wk > 0:
+                    for b in range(B):
+                        v = colours[k, r, c, b]
+                        if v == v:
+                            out[b, r, c] += wk * v
 
 
 def mosaic_tile(
@@ -247,8 +283,8 @@ def mosaic_tile(
             m = w[k] > 0
             if m.any() and not correction.is_identity(int(i)):
                 colours[k][m] = correction.apply(int(i), colours[k][m], store.dtype).astype(np.float32)
-    col = np.where(np.isfinite(colours), colours, 0.0)
-    values = np.einsum("krc,krcb->brc", w, col, optimize=True).astype(np.float32)
+    values = np.empty((bands, rows, cols), np.float32)
+    _blend(w, colours, values)
     alpha = labels >= 0
     glabel = np.where(alpha, views.cands[np.clip(labels, 0, K - 1)], -1).astype(np.int64)
     return TileMosaic(values, alpha, glabel, occl)

@@ -48,7 +48,7 @@ from .color import ColorCorrection, estimate_corrections, to_channels
 from .mosaic import ImageStore, MosaicParams, candidate_colours, mosaic_tile, to_dtype
 from .seams import dissolve, region_polygons
 from .surface import PlanTransform, open_surface, same_crs, transform_bounds
-from .views import prepare_views, tile_views
+from .views import HeightBlocks, prepare_views, tile_views
 from .zbuffer import occluder_wall_min
 
 
@@ -92,6 +92,12 @@ class TrueOrthoConfig:
         tan(MAX_VIEW_ANGLE); steps below twice that cannot hide a cell seen within that angle).
     zbuffer_oversample : float
         Depth-buffer pixels per output cell when the image pixel is finer than the cell.
+    views_per_cell : int
+        Candidates of a tile are evaluated in order of their resolution over the tile; a cell
+        takes no further candidate once this many images see it cleanly (visible, not next to
+        an occluder), so later candidates run only on the cells still short of views (occluded
+        cells, tile corners). 0 evaluates every image for every cell. The colour statistics
+        always use every image.
     image_cache_mb : int
         Bound of the decoded-image cache.
     color_cells : int
@@ -119,6 +125,7 @@ class TrueOrthoConfig:
     edge_shift: float = 0.75
     wall_min: float | None = None
     zbuffer_oversample: float = 1.0
+    views_per_cell: int = 0
     image_cache_mb: int = 1024
     color_cells: int = 60_000
     workers: int = 2
@@ -138,6 +145,8 @@ class TrueOrthoConfig:
             bad("max_view_angle", "expected degrees in (0, 89)")
         if not isinstance(self.blend_width, int) or not 0 <= self.blend_width <= 1000:
             bad("blend_width", "expected an integer number of cells in [0, 1000]")
+        if not isinstance(self.views_per_cell, int) or not 0 <= self.views_per_cell <= 1000:
+            bad("views_per_cell", "expected an integer >= 0 (0 = every image)")
         if not isinstance(self.tile_size, int) or not 32 <= self.tile_size <= 8192:
             bad("tile_size", "expected an integer in [32, 8192]")
         for name in ("depth_tolerance", "zbuffer_oversample"):
@@ -299,7 +308,10 @@ def true_ortho(
         wall_min,
         cfg.discontinuity,
         cfg.edge_shift,
+        views_per_cell=cfg.views_per_cell,
     )
+    if cfg.visibility and setup.margin_cells > 0:
+        setup.blocks = HeightBlocks.of(surf, grid)
     # ---- images that can contribute: on disk, one band count and dtype
     ex_x, ex_y = to_local.xy(np.array([gx0, gx1, gx0, gx1]), np.array([gy0, gy0, gy1, gy1]))
     b = setup.boxes
@@ -425,12 +437,13 @@ def true_ortho(
         done: dict[tuple[int, int], tuple] = {}  # labels of the cores of the previous and current tile row
         for n, tile in enumerate(tiles):
             check(progress)
-            views = tile_views(setup, surf, grid, tile, to_local, workers)
+            fixed = _fixed_labels(tile, done)
+            prefer = np.unique(fixed[fixed >= 0])
+            views = tile_views(setup, surf, grid, tile, to_local, workers, prefer=prefer)
             tri_max = max(tri_max, views.triangles)
             if len(views.cands):
                 isl = tile.inner_slices
                 n_samples += int(views.usable[:, isl[0], isl[1]].sum())
-            fixed = _fixed_labels(tile, done)
             m = mosaic_tile(views, store, correction, res, params, fixed)
             sl = tile.inner_slices
             vals = to_dtype(m.values[:, sl[0], sl[1]], dtype)
@@ -516,7 +529,7 @@ def _estimate_colour(
     # the depth margin is in cells of the grid used
     import dataclasses
 
-    st = dataclasses.replace(setup, margin_cells=int(math.ceil(setup.margin_cells / f)) + 1)
+    st = dataclasses.replace(setup, margin_cells=int(math.ceil(setup.margin_cells / f)) + 1, views_per_cell=0)
     tiles = g.tiles(cfg.tile_size, 0)
     cells, imgs, vals = [], [], []
     for n, tile in enumerate(tiles):

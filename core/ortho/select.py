@@ -52,12 +52,37 @@ NO_LABEL = -1
 
 def data_costs(eff_res: np.ndarray, visible: np.ndarray, near_edge: np.ndarray, edge_penalty: float = 1.0):
     """Data cost ``(K, rows, cols)`` float32, inf where not visible (see module docstring)."""
-    e = np.where(visible, eff_res, np.inf).astype(np.float64)
-    best = np.min(e, axis=0) if len(e) else np.zeros(visible.shape[1:])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        cost = e / best[None] - 1.0
-    cost = np.where(visible, cost + np.where(near_edge, edge_penalty, 0.0), np.inf)
-    return cost.astype(np.float32)
+    K = visible.shape[0]
+    out = np.empty(visible.shape, np.float32)
+    if K:
+        _data_costs(
+            np.ascontiguousarray(eff_res, np.float32),
+            np.ascontiguousarray(visible),
+            np.ascontiguousarray(near_edge),
+            float(edge_penalty),
+            out,
+        )
+    return out
+
+
+@njit
+def _data_costs(eff, vis, edge, penalty, out):
+    K, rows, cols = vis.shape
+    for r in range(rows):
+        for c in range(cols):
+            best = np.inf
+            for k in range(K):
+                if vis[k, r, c] and eff[k, r, c] < best:
+                    best = eff[k, r, c]
+            best = max(best, 1e-30)
+            for k in range(K):
+                if vis[k, r, c]:
+                    v = np.float64(eff[k, r, c]) / np.float64(best) - 1.0
+                    if edge[k, r, c]:
+                        v += penalty
+                    out[k, r, c] = v
+                else:
+                    out[k, r, c] = np.inf
 
 
 def edge_weights(h: np.ndarray, h0: float):
@@ -241,6 +266,14 @@ def _icm(labels, frozen, cost, lum, wh, wv, smooth, contrast, sweeps):
                 if not free[r, c]:
                     continue
                 cur = labels[r, c]
+                if (
+                    cur == best_data[r, c]
+                    and (c == 0 or labels[r, c - 1] == cur)
+                    and (c == cols - 1 or labels[r, c + 1] == cur)
+                    and (r == 0 or labels[r - 1, c] == cur)
+                    and (r == rows - 1 or labels[r + 1, c] == cur)
+                ):
+                    continue  # no seam and the best data cost: no label can do better
                 cand[0] = cur
                 cand[1] = best_data[r, c]
                 cand[2] = labels[r, c - 1] if c > 0 else -1

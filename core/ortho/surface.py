@@ -207,6 +207,20 @@ class DsmSurface:
 
         dst = np.full(grid.shape, np.nan, np.float64)
         with rasterio.open(self.path) as ds:
+            win = _aligned_window(ds, grid, self.crs)
+            if win is not None:  # same CRS and cells: a windowed read, no resampling
+                r0, c0 = win
+                rs0, cs0 = max(r0, 0), max(c0, 0)
+                rs1, cs1 = min(r0 + grid.rows, ds.height), min(c0 + grid.cols, ds.width)
+                if rs1 > rs0 and cs1 > cs0:
+                    from rasterio.windows import Window
+
+                    a = ds.read(self.band, window=Window(cs0, rs0, cs1 - cs0, rs1 - rs0)).astype(np.float64)
+                    if ds.nodata is not None:
+                        a[a == ds.nodata] = np.nan
+                    dst[rs0 - r0 : rs1 - r0, cs0 - c0 : cs1 - c0] = a
+                dst[~np.isfinite(dst)] = np.nan
+                return dst
             try:
                 reproject(
                     source=rasterio.band(ds, self.band),
@@ -287,6 +301,21 @@ class ArraySurface(DsmSurface):
         return dst
 
 
+def _aligned_window(ds, grid: RasterGrid, crs) -> tuple[int, int] | None:
+    """(row, col) of ``grid``'s first cell in the raster ``ds`` when both share CRS, cell size and
+    cell edges (north-up), else None."""
+    t = ds.transform
+    if not (t.b == 0 and t.d == 0 and t.e < 0) or not same_crs(grid.crs or crs, crs):
+        return None
+    if not (math.isclose(t.a, grid.res, rel_tol=1e-9) and math.isclose(-t.e, grid.res, rel_tol=1e-9)):
+        return None
+    fr = (t.f - grid.y_max) / grid.res
+    fc = (grid.x_min - t.c) / grid.res
+    if abs(fr - round(fr)) > 1e-6 or abs(fc - round(fc)) > 1e-6:
+        return None
+    return int(round(fr)), int(round(fc))
+
+
 def _resampling(surface, grid: RasterGrid):
     """Nearest neighbour (sharp outlines) unless the DSM is much coarser than the output grid.
 
@@ -303,6 +332,32 @@ def _resampling(surface, grid: RasterGrid):
     return Resampling.nearest
 
 
+@njit
+def _step_tops(h, wall_min, ring, out):
+    """Cells within ``ring`` 4-neighbour steps (Manhattan distance) of a height step above ``wall_min``."""
+    rows, cols = h.shape
+    for r in range(rows):
+        for c in range(cols):
+            step = False
+            if c + 1 < cols and abs(h[r, c + 1] - h[r, c]) > wall_min:
+                step = True
+            elif c > 0 and abs(h[r, c - 1] - h[r, c]) > wall_min:
+                step = True
+            elif r + 1 < rows and abs(h[r + 1, c] - h[r, c]) > wall_min:
+                step = True
+            elif r > 0 and abs(h[r - 1, c] - h[r, c]) > wall_min:
+                step = True
+            if not step:
+                continue
+            for dr in range(-ring, ring + 1):
+                rr = r + dr
+                if rr < 0 or rr >= rows:
+                    continue
+                w = ring - abs(dr)
+                for cc in range(max(c - w, 0), min(c + w + 1, cols)):
+                    out[rr, cc] = True
+
+
 def grid_triangles(
     grid: RasterGrid, heights: np.ndarray, include, to_local: PlanTransform, wall_min: float, ring: int = 2
 ) -> Triangles:
@@ -313,17 +368,9 @@ def grid_triangles(
     visibility of the DSM's own cells (:func:`~.zbuffer.dsm_triangles`), far
     fewer triangles than every cell top.
     """
-    from scipy.ndimage import binary_dilation
-
-    with np.errstate(invalid="ignore"):
-        step = np.zeros(heights.shape, bool)
-        de = np.abs(heights[:, 1:] - heights[:, :-1]) > wall_min
-        ds = np.abs(heights[1:, :] - heights[:-1, :]) > wall_min
-    step[:, 1:] |= de
-    step[:, :-1] |= de
-    step[1:, :] |= ds
-    step[:-1, :] |= ds
-    tops = binary_dilation(step, iterations=ring) if ring > 0 and step.any() else step
+    h = np.ascontiguousarray(heights, dtype=np.float64)
+    tops = np.zeros(h.shape, np.bool_)
+    _step_tops(h, float(wall_min), int(max(ring, 0)), tops)
     if to_local.identity:
         o = to_local.offset
         return dsm_triangles(

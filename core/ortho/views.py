@@ -28,14 +28,16 @@ is usable in every image whose frame contains its projection.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..geometry.camera import Camera
 from ..grid import RasterGrid, Tile
+from ..jit import njit
 from .surface import PlanTransform
-from .zbuffer import frame_cells, render_depth, view_cells
+from .zbuffer import frame_cells, project, render_depth, view_cells
 
 
 @dataclass
@@ -55,6 +57,74 @@ class ViewSetup:
     wall_min: float
     discontinuity: float = 1.0  # height step (m) of a building outline for the edge shift
     edge_shift: float = 0.75  # cells
+    views_per_cell: int = 0  # clean views after which a cell takes no further candidate (0 = all)
+    blocks: HeightBlocks | None = None  # block maxima/minima of the surface: a margin per tile
+
+
+@dataclass
+class HeightBlocks:
+    """Highest and lowest surface height (world) of every ``block x block`` cells of a grid.
+
+    Lets a tile's occluder margin follow the heights around it instead of the whole surface's
+    range (:meth:`margin`): next to a tower the margin is the tower's reach, in open country a few
+    cells; the depth buffers hold the same occluders either way (a cell beyond the margin cannot
+    pass the test of :func:`tile_views`).
+    """
+
+    grid: RasterGrid
+    block: int
+    hmax: np.ndarray  # (rows, cols) of blocks, -inf where no data
+    hmin: np.ndarray  # +inf where no data
+
+    @classmethod
+    def of(cls, surface, grid: RasterGrid, block: int = 32, strip_cells: int = 4_000_000) -> HeightBlocks:
+        """Read the surface on ``grid`` by strips of whole block rows (bounded memory)."""
+        nbr, nbc = -(-grid.rows // block), -(-grid.cols // block)
+        hmax = np.full((nbr, nbc), -np.inf)
+        hmin = np.full((nbr, nbc), np.inf)
+        rows_per = max(1, strip_cells // max(grid.cols * block, 1)) * block
+        for r0 in range(0, grid.rows, rows_per):
+            nr = min(rows_per, grid.rows - r0)
+            h = surface.heights_on(grid.window(r0, 0, nr, grid.cols))
+            pr, pc = -(-nr // block) * block, nbc * block
+            a = np.full((pr, pc), np.nan)
+            a[:nr, : grid.cols] = h
+            a = a.reshape(pr // block, block, nbc, block)
+            with np.errstate(invalid="ignore"), warnings.catch_warnings():
+                warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN blocks
+                mx = np.nanmax(a, axis=(1, 3))
+                mn = np.nanmin(a, axis=(1, 3))
+            b0 = r0 // block
+            hmax[b0 : b0 + len(mx)] = np.where(np.isfinite(mx), mx, -np.inf)
+            hmin[b0 : b0 + len(mn)] = np.where(np.isfinite(mn), mn, np.inf)
+        return cls(grid, block, hmax, hmin)
+
+    def _blocks(self, x0: float, y0: float, x1: float, y1: float) -> tuple[slice, slice]:
+        g, b = self.grid, self.block * self.grid.res
+        c0 = max(int(math.floor((x0 - g.x_min) / b)), 0)
+        c1 = min(int(math.floor((x1 - g.x_min) / b)) + 1, self.hmax.shape[1])
+        r0 = max(int(math.floor((g.y_max - y1) / b)), 0)
+        r1 = min(int(math.floor((g.y_max - y0) / b)) + 1, self.hmax.shape[0])
+        return slice(r0, max(r1, r0)), slice(c0, max(c1, c0))
+
+    def margin(self, window: RasterGrid, max_margin: int, tan_view: float) -> int:
+        """Occluder margin (cells of ``window``) of a window: at most ``max_margin``."""
+        x0, y0, x1, y1 = window.extent
+        inner = self._blocks(x0, y0, x1, y1)
+        low = self.hmin[inner]
+        if not low.size or not np.isfinite(low).any():
+            return max_margin
+        zlow = float(np.min(low))
+        d = max_margin * window.res
+        high = self.hmax[self._blocks(x0 - d, y0 - d, x1 + d, y1 + d)]
+        if not high.size:
+            return max_margin
+        top = float(np.max(high))
+        if not np.isfinite(top):
+            return max_margin
+        # a cell d cells away enters the depth buffer when h - zlow > d res / tan - res
+        need = int(math.ceil((max(top - zlow, 0.0) + window.res) * tan_view / window.res)) + 2
+        return min(max_margin, need)
 
 
 def image_boxes(images, cameras, zmin: float, zmax: float) -> np.ndarray:
@@ -109,6 +179,7 @@ def prepare_views(
     discontinuity: float = 0.5,
     edge_shift: float = 0.75,
     max_margin_cells: int = 1024,
+    views_per_cell: int = 0,
 ) -> ViewSetup:
     images = list(orientation.images)
     cams = [orientation.camera_of(im) for im in images]
@@ -134,6 +205,7 @@ def prepare_views(
         wall_min,
         max(float(discontinuity), 2.0 * res),
         float(edge_shift),
+        int(views_per_cell),
     )
 
 
@@ -212,13 +284,61 @@ def edge_shift(h: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
     return dx, dy
 
 
+@njit
+def _include_mask(hreg, M, rows, cols, zlow, inv_tan, res, out):
+    """Cells of the region that may occlude the window: inside it, or higher than ``zlow`` by more
+    than their plan distance to it over tan(max view angle), less a cell (NaN: no)."""
+    for r in range(hreg.shape[0]):
+        dr = max(M - r, r - (M + rows - 1), 0)
+        for c in range(hreg.shape[1]):
+            dc = max(M - c, c - (M + cols - 1), 0)
+            if dr == 0 and dc == 0:
+                out[r, c] = True
+            else:
+                d = math.sqrt(dr * dr + dc * dc) * res
+                out[r, c] = hreg[r, c] - zlow > d * inv_tan - res
+
+
+def _tile_scores(setup: ViewSetup, cands: np.ndarray, vidx: np.ndarray, P: np.ndarray) -> np.ndarray:
+    """Predicted effective resolution of each candidate over a tile (smaller is better).
+
+    The pixel footprint at the tile's central surface point over the cosine of the off-nadir
+    angle there (flat ground); times 10 when that point is outside the image frame, so images
+    seeing only a corner of the tile come after those seeing its centre.
+    """
+    c = P[vidx].mean(axis=0)
+    out = np.empty(len(cands))
+    for n, k in enumerate(cands):
+        im, cam = setup.images[k], setup.cameras[k]
+        d = c - np.asarray(im.C, float)
+        dist = float(np.linalg.norm(d))
+        cosv = max(abs(float(d[2])) / max(dist, 1e-12), 1e-3)
+        out[n] = dist / cam.fx / cosv
+        u, v, z = project(c[None], im.R, im.C, cam)[0]
+        if not (z > 0 and -0.5 <= u < cam.width - 0.5 and -0.5 <= v < cam.height - 0.5):
+            out[n] *= 10.0
+    return out
+
+
 def tile_views(
-    setup: ViewSetup, surface, grid: RasterGrid, tile: Tile, to_local: PlanTransform, workers: int = 1
+    setup: ViewSetup,
+    surface,
+    grid: RasterGrid,
+    tile: Tile,
+    to_local: PlanTransform,
+    workers: int = 1,
+    prefer=None,
 ) -> TileViews:
-    """Visibility and view quality of the outer window of ``tile`` (module docstring)."""
+    """Visibility and view quality of the outer window of ``tile`` (module docstring).
+
+    ``prefer``: image indices evaluated first on every cell (the images neighbouring tiles
+    already chose inside this window, so their roofs can continue here).
+    """
     res = grid.res
     outer = tile.outer_grid(grid)
     M = setup.margin_cells
+    if setup.blocks is not None and M > 0:
+        M = setup.blocks.margin(outer, M, math.tan(setup.max_view))
     region = grid.window(tile.outer[0] - M, tile.outer[1] - M, tile.outer[2] + 2 * M, tile.outer[3] + 2 * M)
     hreg = surface.heights_on(region)
     h = hreg[M : M + outer.rows, M : M + outer.cols]
@@ -252,12 +372,8 @@ def tile_views(
     tris = None
     if setup.visibility:
         zlow = float(np.nanmin(h))
-        rr, cc = np.mgrid[0 : region.rows, 0 : region.cols]
-        dr = np.maximum(np.maximum(M - rr, rr - (M + rows - 1)), 0)
-        dc = np.maximum(np.maximum(M - cc, cc - (M + cols - 1)), 0)
-        dist = np.hypot(dr, dc) * res
-        with np.errstate(invalid="ignore"):
-            include = (dist == 0) | (hreg - zlow > dist / math.tan(setup.max_view) - res)
+        include = np.empty(hreg.shape, np.bool_)
+        _include_mask(hreg, M, rows, cols, zlow, 1.0 / math.tan(setup.max_view), res, include)
         tris = surface.triangles(region, hreg, include, to_local, setup.wall_min)
     normals3 = _normals(h, res)
     normals = np.ascontiguousarray(normals3.reshape(-1, 3))
@@ -282,15 +398,14 @@ def tile_views(
             S[mi, 0], S[mi, 1], S[mi, 2] = slx, sly, sz
 
     vidx = np.flatnonzero(vflat)
-    Pv = np.ascontiguousarray(P[vidx])
 
-    def one(k):
+    def one(k, cells):
         im = setup.images[k]
         cam = setup.cameras[k]
-        sub, uvp, dist = frame_cells(Pv, im.R, im.C, cam, setup.max_view)
+        sub, uvp, dist = frame_cells(P[cells], im.R, im.C, cam, setup.max_view)
         if not len(sub):
             return None
-        idx = vidx[sub]
+        idx = cells[sub]
         gsd = float(np.median(dist)) / cam.fx
         scale = min(1.0, setup.oversample * gsd / res) if setup.visibility else 1.0
         zb = win = None
@@ -323,13 +438,41 @@ def tile_views(
         )
         return idx[good], ne[good], uvk[good], eff[good], gsd
 
-    if workers > 1 and len(cand_all) > 1:
+    # candidates in order of their resolution over the tile; with ``views_per_cell`` a cell stops
+    # taking further candidates once that many see it cleanly (the later ones run only on the rest)
+    order = cand_all[np.argsort(_tile_scores(setup, cand_all, vidx, P), kind="stable")]
+    if prefer is not None and len(prefer):
+        first = np.isin(order, np.asarray(prefer))
+        order = np.concatenate([order[first], order[~first]])
+    clean_count = np.zeros(rows * cols, np.int32)
+    cells = vidx
+    results_by: dict[int, tuple | None] = {}
+    batch = max(1, int(workers))
+    pool = None
+    if workers > 1 and len(order) > 1:
         from concurrent.futures import ThreadPoolExecutor
 
-        with ThreadPoolExecutor(max_workers=workers) as pool:
-            results = list(pool.map(one, cand_all))
-    else:
-        results = [one(k) for k in cand_all]
+        pool = ThreadPoolExecutor(max_workers=workers)
+    try:
+        for b0 in range(0, len(order), batch):
+            ks = order[b0 : b0 + batch]
+            if pool is not None and len(ks) > 1:
+                res_b = list(pool.map(one, ks, [cells] * len(ks)))
+            else:
+                res_b = [one(k, cells) for k in ks]
+            for k, r in zip(ks, res_b, strict=True):
+                results_by[int(k)] = r
+                if r is not None and setup.views_per_cell > 0:
+                    clean_count[r[0][~r[1]]] += 1
+            if setup.views_per_cell > 0:
+                cells = cells[clean_count[cells] < setup.views_per_cell]
+                if not len(cells):
+                    break
+    finally:
+        if pool is not None:
+            pool.shutdown()
+    cand_all = np.array(sorted(results_by), np.int64)
+    results: list = [results_by[int(k)] for k in cand_all]
     keep = [i for i, r in enumerate(results) if r is not None and len(r[0])]
     if not keep:
         return empty

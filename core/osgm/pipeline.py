@@ -52,9 +52,9 @@ from ..parallel import (
 )
 from ..progress import Progress, as_progress
 from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
-from .levels import LevelPlan, coarse_windows, plan_levels, refine_windows
+from .levels import MAX_BAND, LevelPlan, coarse_windows, plan_levels, refine_windows
 from .matching import TileParams, View, choose_images, sample_surface
-from .tiles import TileContext, TileTask, osgm_tile_task
+from .tiles import TileContext, TileTask, osgm_tile_task, task_memory
 from .views import ImagePyramid, check_images, monotonic_radius2
 
 DSM_NODATA = -9999.0
@@ -506,6 +506,7 @@ def _match_system(
         conf = np.full(g.shape, np.nan, np.float32)
         ts = int(cfg.tile_size)
         ov = max(16, ts // 8)
+        side = ts + 2 * ov  # outer tile side, for the memory a task asks of the scheduler
         tiles = g.tiles(ts, ov)
         tasks = _LevelTasks(tiles, g, lv, plan, params, cfg, prev_z, prev_filled, z_surface_windows)
         sub = SubProgress(progress, done_cells / total, (done_cells + g.rows * g.cols) / total)
@@ -518,6 +519,7 @@ def _match_system(
                 cache=cache,
                 key=(lambda t: t.key(base)) if cache is not None else None,
                 label=f"{system.name}: level {lv}",
+                memory=task_memory(side, side, MAX_BAND, params.max_images, 4 * side * side),
             )
         except CancelledError:
             raise CancelledError("OSGM cancelled") from None

@@ -53,9 +53,14 @@ Memory
 Workers run one task at a time (one thread each), so a worker needs the
 memory of one task plus what it caches (the caller's image cache); the
 ``memory_limit`` per worker tells the scheduler and the nanny how much that
-is (a worker above 95 % is restarted and its task retried elsewhere). Dask
-*resources* are not used: a scheduler started separately would hold tasks
-forever when its workers do not declare them.
+is (a worker above 95 % is restarted and its task retried elsewhere).
+``map_tiles(..., memory=bytes)`` also tells the scheduler what one task
+needs, as the Dask *resource* ``MEMORY``: the local cluster's workers declare
+their memory limit as ``MEMORY``, so a task is only placed where it fits; on a
+scheduler started separately the resource is used only when every worker
+declares it (``dask worker --resources MEMORY=8e9``), since a scheduler holds
+a task forever when no worker declares a resource it asks for. A task asking
+for more than the largest worker declares asks for that worker's amount.
 """
 
 from __future__ import annotations
@@ -104,6 +109,7 @@ class Executor(Protocol):
         cache: TileCache | None = None,
         key: Callable[[Any], str] | None = None,
         label: str = "",
+        memory: int | None = None,
     ) -> list: ...
 
     def close(self) -> None: ...
@@ -126,7 +132,9 @@ class _Base:
     def describe(self) -> str:
         return self.name
 
-    def map_tiles(self, fn, tasks, progress=None, *, shared=None, cache=None, key=None, label=""):
+    def map_tiles(
+        self, fn, tasks, progress=None, *, shared=None, cache=None, key=None, label="", memory=None
+    ):
         progress = as_progress(progress)
         n = len(tasks)
         results: list = [None] * n
@@ -158,10 +166,10 @@ class _Base:
                 cache.put(k, value)
             finished(i, value)
 
-        self._run(fn, n, materialise, store, shared, progress)
+        self._run(fn, n, materialise, store, shared, progress, memory)
         return results
 
-    def _run(self, fn, n, materialise, store, shared, progress) -> None:
+    def _run(self, fn, n, materialise, store, shared, progress, memory=None) -> None:
         raise NotImplementedError
 
 
@@ -170,7 +178,7 @@ class InProcessExecutor(_Base):
 
     name = "inprocess"
 
-    def _run(self, fn, n, materialise, store, shared, progress) -> None:
+    def _run(self, fn, n, materialise, store, shared, progress, memory=None) -> None:
         global _cancel_hook
         for i in range(n):
             got = materialise(i)
@@ -204,10 +212,21 @@ class _DaskBase(_Base):
         threads = sum(client.nthreads().values()) or 1
         return max(2, 2 * threads)
 
-    def _run(self, fn, n, materialise, store, shared, progress) -> None:
+    def _resources(self, client, memory) -> dict | None:
+        """``{"MEMORY": bytes}`` when every worker declares MEMORY (module docstring), else None."""
+        if not memory:
+            return None
+        workers = client.scheduler_info().get("workers", {}).values()
+        declared = [w.get("resources", {}).get("MEMORY") for w in workers]
+        if not declared or any(d is None for d in declared):
+            return None
+        return {"MEMORY": float(min(int(memory), max(declared)))}
+
+    def _run(self, fn, n, materialise, store, shared, progress, memory=None) -> None:
         from distributed import wait
 
         client = self._client()
+        resources = self._resources(client, memory)
         run = uuid.uuid4().hex[:12]
         shared_f = None
         if shared is not None:
@@ -228,7 +247,12 @@ class _DaskBase(_Base):
                     task, k = got
                     args = (task,) if shared_f is None else (shared_f, task)
                     f = client.submit(
-                        fn, *args, key=f"truortho-tile-{run}-{i}", retries=self.retries, pure=False
+                        fn,
+                        *args,
+                        key=f"truortho-tile-{run}-{i}",
+                        retries=self.retries,
+                        pure=False,
+                        resources=resources,
                     )
                     running[f] = (i, k)
                 if not running:
@@ -317,6 +341,7 @@ class LocalDaskExecutor(_DaskBase):
                 memory_limit=self.memory_limit,
                 dashboard_address=None,
                 env={"NUMBA_NUM_THREADS": str(self.numba_threads)},
+                resources={"MEMORY": float(parse_memory(self.memory_limit) or _worker_memory_default(1))},
             )
             self.client = Client(self.cluster)
         return self.client

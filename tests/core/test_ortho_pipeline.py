@@ -143,6 +143,21 @@ def test_tiles_do_not_change_the_result(data):
     assert small.stats["tiles"] > 1 and big.stats["tiles"] == 1
 
 
+def test_views_per_cell_keeps_what_is_seen_and_the_quality(data):
+    """Lazy candidates (VIEWS_PER_CELL): fewer (cell, image) samples, the same cells seen and
+    occluded (a cell short of views tries every image), ghosting and dE as with every image."""
+    full = _run(data, "vpc0", color_correction=False)
+    lazy = _run(data, "vpc3", color_correction=False, views_per_cell=3)
+    assert lazy.stats["cell_image_samples"] < 0.8 * full.stats["cell_image_samples"]
+    of, _, _ = read_raster(full.occlusion)
+    ol, _, _ = read_raster(lazy.occlusion)
+    assert np.array_equal(of, ol)
+    mf, ml = _measures(data, full.output), _measures(data, lazy.output)
+    print("all images", mf, "\nviews_per_cell=3", ml, lazy.stats["cell_image_samples"])
+    assert ml["ghost"] <= max(0.01, 1.5 * mf["ghost"])
+    assert ml["dE"] <= mf["dE"] + 0.5 and ml["coverage"] == mf["coverage"]
+
+
 def test_bad_input_gives_clear_errors_and_no_output(data, tmp_path):
     f = data["folder"]
     ext = data["scene"].extent_world()

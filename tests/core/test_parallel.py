@@ -8,11 +8,8 @@ reuses the cached tiles and a run with other parameters reuses none; cancel writ
 
 from __future__ import annotations
 
-import json
 import os
 import signal
-import subprocess
-import sys
 import time
 from pathlib import Path
 
@@ -79,50 +76,13 @@ def reference(scene, tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def cluster():
-    ex = LocalDaskExecutor(n_workers=2, memory_limit="1.5GiB")
-    yield ex
-    ex.close()
+def cluster(dask_cluster):
+    return dask_cluster
 
 
 @pytest.fixture(scope="module")
-def scheduler_file(tmp_path_factory):
-    """``dask scheduler`` and two ``dask worker`` processes on 127.0.0.1, stopped at the end."""
-    folder = tmp_path_factory.mktemp("scheduler")
-    sfile = folder / "scheduler.json"
-    env = dict(os.environ, NUMBA_NUM_THREADS="1")
-    cli = [sys.executable, "-m", "dask"]
-    procs = [
-        subprocess.Popen(
-            [*cli, "scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
-             "--scheduler-file", str(sfile)],
-            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=folder,
-        )
-    ]  # fmt: skip
-    try:
-        deadline = time.monotonic() + 60
-        while not sfile.exists() and time.monotonic() < deadline:
-            time.sleep(0.2)
-        assert sfile.exists(), "the scheduler did not start"
-        assert json.loads(sfile.read_text())["address"].startswith("tcp://127.0.0.1:")
-        for _ in range(2):
-            procs.append(
-                subprocess.Popen(
-                    [*cli, "worker", "--scheduler-file", str(sfile), "--host", "127.0.0.1", "--nthreads", "1",
-                     "--nworkers", "1", "--memory-limit", "1.5GiB", "--no-dashboard"],
-                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=folder,
-                )
-            )  # fmt: skip
-        yield str(sfile)
-    finally:
-        for p in reversed(procs):
-            p.terminate()
-        for p in reversed(procs):
-            try:
-                p.wait(timeout=20)
-            except subprocess.TimeoutExpired:
-                p.kill()
-                p.wait()
+def scheduler_file(dask_scheduler_file):
+    return dask_scheduler_file
 
 
 # ------------------------------------------------------------------ the same products everywhere
