@@ -34,137 +34,162 @@
             <translation>Bildmessungen der Passpunkte (Tabelle)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="31" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="34" />
             <source>Filter DSM (outliers, holes, smoothing, DTM)</source>
             <translation>DOM filtern (Ausreißer, Lücken, Glättung, DGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="236" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="284" />
             <source>Filtered DSM</source>
             <translation>Gefiltertes DOM</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="60" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="67" />
             <source>Raw DSM</source>
             <translation>Rohes DOM</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="62" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="69" />
             <source>Confidence raster [0, 1]</source>
             <translation>Konfidenzraster [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="67" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="74" />
             <source>Outlier threshold (m; empty = 4 x resolution)</source>
             <translation>Ausreißerschwelle (m; leer = 4 x Auflösung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="74" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="81" />
             <source>Largest hole width filled (m)</source>
             <translation>Größte gefüllte Lückenbreite (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="75" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="82" />
             <source>Sharpen blurred height steps</source>
             <translation>Verschliffene Höhensprünge schärfen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="78" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="85" />
             <source>Edge-preserving smoothing of planar surfaces</source>
             <translation>Kantenerhaltende Glättung ebener Flächen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="84" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="91" />
             <source>Outlier window (cells, odd)</source>
             <translation>Ausreißerfenster (Zellen, ungerade)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="93" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="100" />
             <source>Supporting neighbours that keep a cell</source>
             <translation>Stützende Nachbarn, die eine Zelle erhalten</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="97" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="104" />
             <source>Minimum confidence</source>
             <translation>Mindestkonfidenz</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="103" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="110" />
             <source>Confident cells (confidence at least)</source>
             <translation>Zuverlässige Zellen (Konfidenz mindestens)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="112" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="119" />
             <source>Height step between surfaces (m)</source>
             <translation>Höhensprung zwischen Oberflächen (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="116" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="123" />
             <source>Smoothing radius (cells)</source>
             <translation>Glättungsradius (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="122" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="129" />
             <source>Smoothing height tolerance (m; empty = 2.5 x resolution)</source>
             <translation>Höhentoleranz der Glättung (m; leer = 2,5 x Auflösung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="133" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="140" />
             <source>Ground filter cell size (m; empty = max(1 m, resolution))</source>
             <translation>Zellgröße des Bodenfilters (m; leer = max(1 m, Auflösung))</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="142" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="149" />
             <source>Ground filter window radius (m)</source>
             <translation>Fensterradius des Bodenfilters (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="146" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="153" />
             <source>Ground filter slope (rise/run)</source>
             <translation>Neigung des Bodenfilters (Höhe/Strecke)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="152" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="159" />
+            <source>Run tiles on</source>
+            <translation>Kacheln ausführen auf</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="174" />
+            <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
+            <translation>Adresse des Dask-Schedulers (tls://host:port oder Scheduler-Datei; leer = TRUORTHO_DASK_SCHEDULER)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="186" />
             <source>Terrain model (DTM)</source>
             <translation>Geländemodell (DGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="157" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="191" />
             <source>Normalised DSM (height above terrain)</source>
             <translation>Normalisiertes DOM (Höhe über Gelände)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="160" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="194" />
             <source>Statistics (JSON)</source>
             <translation>Statistik (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="161" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="195" />
             <source>Outliers removed (cells)</source>
             <translation>Entfernte Ausreißer (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="196" />
             <source>Hole cells filled</source>
             <translation>Gefüllte Lückenzellen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="163" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="197" />
             <source>Holes left as nodata</source>
             <translation>Als NoData verbliebene Lücken</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="238" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="286" />
             <source>DTM</source>
             <translation>DGM</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="197" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="161" />
+            <source>inprocess: this process (all cores)</source>
+            <translation>inprocess: dieser Prozess (alle Kerne)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <source>local: a Dask cluster of worker processes on this computer</source>
+            <translation>local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="163" />
+            <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
+            <translation>scheduler: ein Dask-Scheduler (SCHEDULER_ADDRESS)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="246" />
             <source>{} holes ({} cells, widest {:.1f} m) are wider than {} m and stay nodata</source>
             <translation>{} Lücken ({} Zellen, breiteste {:.1f} m) sind breiter als {} m und bleiben NoData</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="226" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="274" />
             <source>Ground filter at {:.2f} m: {:.1f} % of the cells are ground</source>
             <translation>Bodenfilter mit {:.2f} m: {:.1f} % der Zellen sind Boden</translation>
         </message>
@@ -629,16 +654,6 @@
             <translation>Kachelgröße (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="169" />
-            <source>Run tiles on</source>
-            <translation>Kacheln ausführen auf</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/osgm.py" line="184" />
-            <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
-            <translation>Adresse des Dask-Schedulers (tls://host:port oder Scheduler-Datei; leer = TRUORTHO_DASK_SCHEDULER)</translation>
-        </message>
-        <message>
             <location filename="../processing/algorithms/osgm.py" line="196" />
             <source>Confidence [0, 1]</source>
             <translation>Konfidenz [0, 1]</translation>
@@ -677,21 +692,6 @@
             <location filename="../processing/algorithms/osgm.py" line="132" />
             <source>auto: extra systems for obliques</source>
             <translation>auto: zusätzliche Systeme für Schrägbilder</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/osgm.py" line="171" />
-            <source>inprocess: this process (all cores)</source>
-            <translation>inprocess: dieser Prozess (alle Kerne)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/osgm.py" line="172" />
-            <source>local: a Dask cluster of worker processes on this computer</source>
-            <translation>local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/osgm.py" line="173" />
-            <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
-            <translation>scheduler: ein Dask-Scheduler (SCHEDULER_ADDRESS)</translation>
         </message>
         <message>
             <location filename="../processing/algorithms/osgm.py" line="245" />
@@ -1465,166 +1465,171 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="299" />
+            <source>Where the tiles are filtered; the filtered DSM and the statistics are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The terrain model is computed in QGIS's process.</source>
+            <translation>Wo die Kacheln gefiltert werden; gefiltertes DOM und Statistik sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen das DOM und das Konfidenzraster unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Das Geländemodell wird im Prozess von QGIS berechnet.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="312" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>Gefiltertes DOM (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="300" />
+            <location filename="../processing/help/__init__.py" line="313" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Optionales Geländemodell (GeoTIFF, float32, DOM-Raster).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="301" />
+            <location filename="../processing/help/__init__.py" line="314" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>Optionales normalisiertes DOM: DOM minus DGM, Höhen über dem Gelände.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="302" />
+            <location filename="../processing/help/__init__.py" line="315" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON: die Filterstatistik (und die des Bodenfilters).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="303" />
+            <location filename="../processing/help/__init__.py" line="316" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Als Ausreißer oder wegen geringer Konfidenz entfernte Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="304" />
+            <location filename="../processing/help/__init__.py" line="317" />
             <source>Hole cells interpolated.</source>
             <translation>Interpolierte Lückenzellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="305" />
+            <location filename="../processing/help/__init__.py" line="318" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Lücken, breiter als MAX_HOLE, als NoData belassen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="310" />
+            <location filename="../processing/help/__init__.py" line="323" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Erzeugt eine Dreiecksvermaschung. Aus einem DOM: ein 2,5D-Netz, dessen Höhensprünge senkrechte Wände sind (kein Dreieck überspannt je einen Sprung) und dessen ebene und glatte Bereiche durch einen eingeschränkten Quadtree mit garantierter Höhenfehlerschranke an jedem Zellmittelpunkt ausgedünnt werden; Eckpunktfarben aus einem optionalen Orthobild. Aus einer Punktwolke (LAS/LAZ oder EPT, z. B. zusammengeführte Zuordnung von Schrägbildern): ein 2,5D-Delaunay-Netz je Referenzsystem, entlang seiner Blickrichtung gesehen (überlappende Schichten, wo Systeme dieselbe Oberfläche sehen; nicht wasserdicht). Schreibt PLY (binär) oder OBJ, im KBS oder in einem lokalen System, dessen Offset im Dateikopf vermerkt ist; truortho:trueortho liest es als SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="319" />
+            <location filename="../processing/help/__init__.py" line="332" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>DOM-Raster (projiziertes KBS) oder Punktwolke (.las, .laz oder eine EPT-ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="320" />
+            <location filename="../processing/help/__init__.py" line="333" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Optionales Orthobild (RGB) für die Eckpunktfarben eines DOM-Netzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="321" />
+            <location filename="../processing/help/__init__.py" line="334" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Größter Höhenunterschied zwischen Netz und DOM an einem Zellmittelpunkt, Meter (leer: halbe DOM-Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="323" />
+            <location filename="../processing/help/__init__.py" line="336" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Kleinster Höhenunterschied zwischen benachbarten Zellen, der zur Wand wird, Meter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="324" />
+            <location filename="../processing/help/__init__.py" line="337" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Steilste als geneigte Dreiecke erhaltene Neigung, Grad: die Sprungschwelle ist max(MIN_STEP, Auflösung x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="326" />
+            <location filename="../processing/help/__init__.py" line="339" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Größter Zellblock, den ein Dreieckspaar abdecken darf (eine Zweierpotenz).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="327" />
+            <location filename="../processing/help/__init__.py" line="340" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Punktwolken: längste Dreieckskante, Meter (leer: 4 x der mittlere Punktabstand).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="328" />
+            <location filename="../processing/help/__init__.py" line="341" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>CRS: Weltkoordinaten (PLY-Doubles). Lokal: Welt minus einem Offset, vermerkt als 'comment offset E N H' (PLY) oder '# offset E N H' (OBJ), für Viewer, die kleine Zahlen benötigen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="330" />
+            <location filename="../processing/help/__init__.py" line="343" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Das Netz: .ply (binär, Little-Endian, 'comment crs ...') oder .obj ('# crs ...', Eckpunktfarben als 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="332" />
+            <location filename="../processing/help/__init__.py" line="345" />
             <source>Number of vertices.</source>
             <translation>Anzahl der Eckpunkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="333" />
+            <location filename="../processing/help/__init__.py" line="346" />
             <source>Number of triangles.</source>
             <translation>Anzahl der Dreiecke.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="334" />
+            <location filename="../processing/help/__init__.py" line="347" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Anzahl der senkrechten Wanddreiecke (DOM-Netze).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="339" />
+            <location filename="../processing/help/__init__.py" line="352" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (Layer &gt; Add Layer &gt; Point Cloud, choose ept.json).</source>
             <translation>Exportiert ein DOM als Punktwolke, ein Punkt je gültigem Zellmittelpunkt, mit Farben aus einem Orthobild und Konfidenz je Punkt aus einem Konfidenzraster: LAS 1.4 oder LAZ (Punktformat 7, KBS als WKT, Zusatzdimensionen 'confidence' und 'system' (das Referenzsystem), ein TruOrtho-VLR, der die Referenzsysteme beschreibt), lesbar mit PDAL, laspy, LAStools und CloudCompare. Daneben wird ein Entwine-Point-Tile-Datensatz (EPT) geschrieben: QGIS-Builds ohne PDAL (wie das QGIS 3.22 von Debian) öffnen ihn als Punktwolken-Layer (Layer &gt; Layer hinzufügen &gt; Punktwolke, ept.json wählen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="347" />
+            <location filename="../processing/help/__init__.py" line="360" />
             <source>DSM raster with a projected CRS.</source>
             <translation>DOM-Raster mit einem projizierten KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="348" />
+            <location filename="../processing/help/__init__.py" line="361" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Optionales Orthobild (RGB) für die Punktfarben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="349" />
+            <location filename="../processing/help/__init__.py" line="362" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Optionales Konfidenzraster in [0, 1], gespeichert als Dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="350" />
+            <location filename="../processing/help/__init__.py" line="363" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Die Punktwolke (.laz komprimiert oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="351" />
+            <location filename="../processing/help/__init__.py" line="364" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Ordner des EPT-Datensatzes (ept.json, ept-data/, ept-hierarchy/); leer lassen, um ihn zu überspringen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="352" />
+            <location filename="../processing/help/__init__.py" line="365" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Pfad der ept.json des EPT-Datensatzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="353" />
+            <location filename="../processing/help/__init__.py" line="366" />
             <source>Number of points written.</source>
             <translation>Anzahl der geschriebenen Punkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="358" />
+            <location filename="../processing/help/__init__.py" line="371" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Führt Punktwolken mehrerer Referenzsysteme (z. B. das Nadir- und die Schrägsysteme der dichten Bildzuordnung) in einer LAS-1.4-/LAZ-Datei zusammen und behält dabei 'system' jedes Punktes (Dateien ohne dieses Attribut erhalten den Index ihrer Datei) und seine Konfidenz; dünnt optional Duplikate auf einem Voxelgitter aus und behält den zuverlässigsten Punkt jedes Voxels; schreibt optional einen EPT-Datensatz für QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="364" />
+            <location filename="../processing/help/__init__.py" line="377" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>LAS/LAZ-Dateien in einem KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="365" />
+            <location filename="../processing/help/__init__.py" line="378" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Voxelgröße für das Ausdünnen, Meter (leer: jeden Punkt behalten).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="366" />
+            <location filename="../processing/help/__init__.py" line="379" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Die zusammengeführte Punktwolke (.laz oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="367" />
+            <location filename="../processing/help/__init__.py" line="380" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Optionaler Ordner für einen EPT-Datensatz der zusammengeführten Wolke.</translation>
         </message>

@@ -34,137 +34,162 @@
             <translation>Mesures image des points d'appui (table)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="31" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="34" />
             <source>Filter DSM (outliers, holes, smoothing, DTM)</source>
             <translation>Filtrer le MNS (valeurs aberrantes, trous, lissage, MNT)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="236" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="284" />
             <source>Filtered DSM</source>
             <translation>MNS filtré</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="60" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="67" />
             <source>Raw DSM</source>
             <translation>MNS brut</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="62" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="69" />
             <source>Confidence raster [0, 1]</source>
             <translation>Raster de confiance [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="67" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="74" />
             <source>Outlier threshold (m; empty = 4 x resolution)</source>
             <translation>Seuil des valeurs aberrantes (m ; vide = 4 x la résolution)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="74" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="81" />
             <source>Largest hole width filled (m)</source>
             <translation>Largeur maximale des trous comblés (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="75" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="82" />
             <source>Sharpen blurred height steps</source>
             <translation>Rendre nets les sauts de hauteur flous</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="78" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="85" />
             <source>Edge-preserving smoothing of planar surfaces</source>
             <translation>Lissage des surfaces planes préservant les arêtes</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="84" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="91" />
             <source>Outlier window (cells, odd)</source>
             <translation>Fenêtre des valeurs aberrantes (cellules, impair)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="93" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="100" />
             <source>Supporting neighbours that keep a cell</source>
             <translation>Voisins d'appui qui conservent une cellule</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="97" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="104" />
             <source>Minimum confidence</source>
             <translation>Confiance minimale</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="103" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="110" />
             <source>Confident cells (confidence at least)</source>
             <translation>Cellules fiables (confiance au moins)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="112" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="119" />
             <source>Height step between surfaces (m)</source>
             <translation>Saut de hauteur entre surfaces (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="116" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="123" />
             <source>Smoothing radius (cells)</source>
             <translation>Rayon de lissage (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="122" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="129" />
             <source>Smoothing height tolerance (m; empty = 2.5 x resolution)</source>
             <translation>Tolérance en hauteur du lissage (m ; vide = 2,5 x la résolution)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="133" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="140" />
             <source>Ground filter cell size (m; empty = max(1 m, resolution))</source>
             <translation>Taille de cellule du filtre de sol (m ; vide = max(1 m, résolution))</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="142" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="149" />
             <source>Ground filter window radius (m)</source>
             <translation>Rayon de fenêtre du filtre de sol (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="146" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="153" />
             <source>Ground filter slope (rise/run)</source>
             <translation>Pente du filtre de sol (dénivelé/distance)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="152" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="159" />
+            <source>Run tiles on</source>
+            <translation>Exécuter les tuiles sur</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="174" />
+            <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
+            <translation>Adresse du planificateur Dask (tls://hôte:port ou fichier de planificateur ; vide = TRUORTHO_DASK_SCHEDULER)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="186" />
             <source>Terrain model (DTM)</source>
             <translation>Modèle numérique de terrain (MNT)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="157" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="191" />
             <source>Normalised DSM (height above terrain)</source>
             <translation>MNS normalisé (hauteur au-dessus du terrain)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="160" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="194" />
             <source>Statistics (JSON)</source>
             <translation>Statistiques (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="161" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="195" />
             <source>Outliers removed (cells)</source>
             <translation>Valeurs aberrantes supprimées (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="196" />
             <source>Hole cells filled</source>
             <translation>Cellules de trous comblées</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="163" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="197" />
             <source>Holes left as nodata</source>
             <translation>Trous laissés en NoData</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="238" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="286" />
             <source>DTM</source>
             <translation>MNT</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="197" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="161" />
+            <source>inprocess: this process (all cores)</source>
+            <translation>inprocess : ce processus (tous les cœurs)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <source>local: a Dask cluster of worker processes on this computer</source>
+            <translation>local : une grappe Dask de processus de travail sur cet ordinateur</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="163" />
+            <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
+            <translation>scheduler : un planificateur Dask (SCHEDULER_ADDRESS)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="246" />
             <source>{} holes ({} cells, widest {:.1f} m) are wider than {} m and stay nodata</source>
             <translation>{} trous ({} cellules, le plus large {:.1f} m) dépassent {} m et restent en NoData</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="226" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="274" />
             <source>Ground filter at {:.2f} m: {:.1f} % of the cells are ground</source>
             <translation>Filtre de sol à {:.2f} m : {:.1f} % des cellules sont du sol</translation>
         </message>
@@ -629,16 +654,6 @@
             <translation>Taille des tuiles (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="169" />
-            <source>Run tiles on</source>
-            <translation>Exécuter les tuiles sur</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/osgm.py" line="184" />
-            <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
-            <translation>Adresse du planificateur Dask (tls://hôte:port ou fichier de planificateur ; vide = TRUORTHO_DASK_SCHEDULER)</translation>
-        </message>
-        <message>
             <location filename="../processing/algorithms/osgm.py" line="196" />
             <source>Confidence [0, 1]</source>
             <translation>Confiance [0, 1]</translation>
@@ -677,21 +692,6 @@
             <location filename="../processing/algorithms/osgm.py" line="132" />
             <source>auto: extra systems for obliques</source>
             <translation>auto : systèmes supplémentaires pour les obliques</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/osgm.py" line="171" />
-            <source>inprocess: this process (all cores)</source>
-            <translation>inprocess : ce processus (tous les cœurs)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/osgm.py" line="172" />
-            <source>local: a Dask cluster of worker processes on this computer</source>
-            <translation>local : une grappe Dask de processus de travail sur cet ordinateur</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/osgm.py" line="173" />
-            <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
-            <translation>scheduler : un planificateur Dask (SCHEDULER_ADDRESS)</translation>
         </message>
         <message>
             <location filename="../processing/algorithms/osgm.py" line="245" />
@@ -1465,166 +1465,171 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="299" />
+            <source>Where the tiles are filtered; the filtered DSM and the statistics are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The terrain model is computed in QGIS's process.</source>
+            <translation>Où les tuiles sont filtrées ; le MNS filtré et les statistiques sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, une tuile après l'autre sur tous les cœurs (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire le MNS et le raster de confiance aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. Le modèle de terrain est calculé dans le processus de QGIS.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="312" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>MNS filtré (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="300" />
+            <location filename="../processing/help/__init__.py" line="313" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Modèle numérique de terrain facultatif (GeoTIFF, float32, grille du MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="301" />
+            <location filename="../processing/help/__init__.py" line="314" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>MNS normalisé facultatif : MNS moins MNT, hauteurs au-dessus du terrain.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="302" />
+            <location filename="../processing/help/__init__.py" line="315" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON : les statistiques du filtre (et celles du filtre de sol).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="303" />
+            <location filename="../processing/help/__init__.py" line="316" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Cellules supprimées comme valeurs aberrantes ou pour confiance insuffisante.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="304" />
+            <location filename="../processing/help/__init__.py" line="317" />
             <source>Hole cells interpolated.</source>
             <translation>Cellules de trous interpolées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="305" />
+            <location filename="../processing/help/__init__.py" line="318" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Trous plus larges que MAX_HOLE, laissés en NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="310" />
+            <location filename="../processing/help/__init__.py" line="323" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Construit un maillage triangulaire. À partir d'un MNS : un maillage 2,5D dont les sauts de hauteur sont des murs verticaux (aucun triangle n'enjambe jamais un saut) et dont les zones planes et lisses sont décimées par un quadtree restreint avec une borne garantie de l'erreur verticale au centre de chaque cellule ; couleurs des sommets issues d'une orthoimage facultative. À partir d'un nuage de points (LAS/LAZ ou EPT, par ex. l'appariement fusionné d'images obliques) : un maillage de Delaunay 2,5D par système de référence, vu selon sa direction de visée (couches superposées là où des systèmes voient la même surface ; non étanche). Écrit du PLY (binaire) ou de l'OBJ, dans le SCR ou dans un repère local dont le décalage est consigné dans l'en-tête ; truortho:trueortho le lit comme SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="319" />
+            <location filename="../processing/help/__init__.py" line="332" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>Raster MNS (SCR projeté) ou nuage de points (.las, .laz, ou un ept.json EPT).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="320" />
+            <location filename="../processing/help/__init__.py" line="333" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Orthoimage facultative (RVB) pour les couleurs des sommets d'un maillage de MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="321" />
+            <location filename="../processing/help/__init__.py" line="334" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Écart vertical maximal entre le maillage et le MNS en tout centre de cellule, en mètres (vide : la moitié de la résolution du MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="323" />
+            <location filename="../processing/help/__init__.py" line="336" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Plus petite différence de hauteur entre cellules voisines qui devient un mur, en mètres.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="324" />
+            <location filename="../processing/help/__init__.py" line="337" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Pente la plus forte conservée en triangles inclinés, en degrés : le seuil de saut vaut max(MIN_STEP, résolution x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="326" />
+            <location filename="../processing/help/__init__.py" line="339" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Plus grand bloc de cellules qu'une paire de triangles peut couvrir (une puissance de deux).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="327" />
+            <location filename="../processing/help/__init__.py" line="340" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Nuages de points : arête de triangle la plus longue, en mètres (vide : 4 x l'espacement médian des points).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="328" />
+            <location filename="../processing/help/__init__.py" line="341" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>SCR : coordonnées terrain (doubles PLY). Local : terrain moins un décalage consigné sous la forme 'comment offset E N H' (PLY) ou '# offset E N H' (OBJ), pour les visionneuses qui ont besoin de petits nombres.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="330" />
+            <location filename="../processing/help/__init__.py" line="343" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Le maillage : .ply (binaire petit-boutiste, 'comment crs ...') ou .obj ('# crs ...', couleurs des sommets sous la forme 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="332" />
+            <location filename="../processing/help/__init__.py" line="345" />
             <source>Number of vertices.</source>
             <translation>Nombre de sommets.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="333" />
+            <location filename="../processing/help/__init__.py" line="346" />
             <source>Number of triangles.</source>
             <translation>Nombre de triangles.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="334" />
+            <location filename="../processing/help/__init__.py" line="347" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Nombre de triangles de murs verticaux (maillages de MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="339" />
+            <location filename="../processing/help/__init__.py" line="352" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (Layer &gt; Add Layer &gt; Point Cloud, choose ept.json).</source>
             <translation>Exporte un MNS en nuage de points, un point par centre de cellule valide, avec les couleurs d'une orthoimage et une confiance par point issue d'un raster de confiance : LAS 1.4 ou LAZ (format de point 7, SCR en WKT, dimensions supplémentaires 'confidence' et 'system' (le système de référence), un VLR TruOrtho décrivant les systèmes de référence), lisible par PDAL, laspy, LAStools et CloudCompare. Un jeu de données Entwine Point Tile (EPT) est écrit à côté : les versions de QGIS sans PDAL (comme le QGIS 3.22 de Debian) l'ouvrent comme couche nuage de points (Couche &gt; Ajouter une couche &gt; Nuage de points, choisir ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="347" />
+            <location filename="../processing/help/__init__.py" line="360" />
             <source>DSM raster with a projected CRS.</source>
             <translation>Raster MNS dans un SCR projeté.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="348" />
+            <location filename="../processing/help/__init__.py" line="361" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Orthoimage facultative (RVB) pour les couleurs des points.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="349" />
+            <location filename="../processing/help/__init__.py" line="362" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Raster de confiance facultatif dans [0, 1], stocké comme dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="350" />
+            <location filename="../processing/help/__init__.py" line="363" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Le nuage de points (.laz compressé, ou .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="351" />
+            <location filename="../processing/help/__init__.py" line="364" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Dossier du jeu de données EPT (ept.json, ept-data/, ept-hierarchy/) ; laisser vide pour ne pas l'écrire.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="352" />
+            <location filename="../processing/help/__init__.py" line="365" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Chemin du fichier ept.json du jeu de données EPT.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="353" />
+            <location filename="../processing/help/__init__.py" line="366" />
             <source>Number of points written.</source>
             <translation>Nombre de points écrits.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="358" />
+            <location filename="../processing/help/__init__.py" line="371" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Fusionne des nuages de points de plusieurs systèmes de référence (par ex. les systèmes nadir et obliques de l'appariement dense) en un seul fichier LAS 1.4 / LAZ, en conservant le 'system' de chaque point (les fichiers qui n'en ont pas reçoivent l'index de leur fichier) et sa confiance ; éclaircit en option les doublons sur une grille de voxels en gardant le point le plus fiable de chaque voxel ; écrit en option un jeu de données EPT pour QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="364" />
+            <location filename="../processing/help/__init__.py" line="377" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>Fichiers LAS/LAZ dans un même SCR.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="365" />
+            <location filename="../processing/help/__init__.py" line="378" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Taille des voxels pour l'éclaircissement, en mètres (vide : conserver tous les points).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="366" />
+            <location filename="../processing/help/__init__.py" line="379" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Le nuage de points fusionné (.laz ou .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="367" />
+            <location filename="../processing/help/__init__.py" line="380" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Dossier facultatif pour un jeu de données EPT du nuage fusionné.</translation>
         </message>

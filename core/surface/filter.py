@@ -44,11 +44,44 @@ tile borders (union-find), and the second pass fills only holes whose merged
 component is small enough. Results do not depend on the tile size, except
 for interpolated values of holes longer than the margin (truncated there,
 with differences far below the noise).
+
+Parallel execution
+------------------
+Each pass is a :meth:`~truortho.core.parallel.Executor.map_tiles` call over
+the tiles (:func:`filter_pass1_task`, :func:`filter_pass2_task`; the tiles of
+a pass are independent given the merge), so :func:`filter_dsm` runs them in
+this process (default), on a local Dask cluster or on a Dask scheduler
+(``executor``); the files are read by every task itself through a
+:class:`FileReader`. The union-find merge, the statistics (summed from the
+task results, in tile order) and the writing of the cores stay in this
+process; pass 2 is submitted in batches of at most :data:`WRITE_BATCH_BYTES`
+(256 MiB) of float32 cores (64 tiles of 1024 x 1024 cells, a raster of
+8192 x 8192 cells, per call) so that this process never holds more of the
+output than that. The tile logic is the same everywhere, so the result is
+bit-identical whichever executor runs it. With ``cache_dir``, finished tile
+tasks are kept in a content-addressed :class:`~truortho.core.parallel.TileCache`
+keyed by :data:`CACHE_VERSION`, the input files (path, size, mtime), the
+band, the grid, every :class:`DsmFilterConfig` field, the tile's windows and,
+in pass 2, which of its holes the merge declared small.
+
+Memory of one task (:func:`task_memory`, passed as ``memory=`` to the
+executor): about :data:`TASK_BYTES_PER_CELL` = 96 bytes per cell of the outer
+window (core + margin): up to eight float64 arrays live at once (heights,
+confidence, the cleaned heights, the sharpened copy, the hole widths or the
+filled and re-solved copies, the smoothed copy, the solver's int64 cell index)
+plus about 32 bytes of int32 labels and boolean masks. The margin is
+``outlier_margin + max_hole / 2 res + 2`` cells in pass 1 and up to
+``outlier_margin + 2.5 max_hole / res + smooth_radius + 7`` in pass 2; with
+the defaults (tile 1024, max_hole 10 m) at 0.25 m, pass 1 tasks have
+1100 x 1100 cells (116 MB) and pass 2 tasks at most 1274 x 1274 (156 MB). The
+sparse Laplace solve of a tile's small holes comes on top (proportional to the
+hole cells, a small share of the tile).
 """
 
 from __future__ import annotations
 
 import math
+import os
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
@@ -57,7 +90,8 @@ import numpy as np
 from ..errors import InputError
 from ..grid import RasterGrid
 from ..jit import pjit, prange
-from ..progress import Progress, Steps, as_progress, check
+from ..parallel import Digest, Executor, InProcessExecutor, TileCache, file_identity
+from ..progress import Progress, Steps, as_progress
 
 #: half side of the window of the confidence pass (15 x 15 cells)
 CONFIDENCE_HALF = 7
@@ -627,68 +661,255 @@ class _Components:
         self.width[ra] = max(self.width[ra], self.width[rb])
 
 
-# ------------------------------------------------------------------ pipeline
-
-Reader = Callable[[int, int, int, int], tuple[np.ndarray, np.ndarray | None]]
-Writer = Callable[[np.ndarray, tuple[int, int, int, int]], None]
+# ------------------------------------------------------------------ tile tasks (run anywhere)
 
 
-def _read_padded(read: Reader, grid: RasterGrid, outer: tuple[int, int, int, int]):
+@dataclass(frozen=True)
+class FileReader:
+    """Windows of a DSM GeoTIFF (and its confidence raster) as float64, NaN for nodata.
+
+    Plain data (picklable), so that a Dask worker opens the files itself.
+    """
+
+    path: str
+    band: int
+    nodata: float | None
+    confidence: str | None
+    same_grid: bool
+    grid: RasterGrid  # the DSM's grid (the confidence raster is resampled onto it unless same_grid)
+
+    def __call__(self, r0: int, c0: int, nr: int, nc: int) -> tuple[np.ndarray, np.ndarray | None]:
+        from ..rasterio_io import read_onto_grid, read_raster
+
+        z, _, _ = read_raster(self.path, self.band, (r0, c0, nr, nc))
+        z = z.astype(np.float64)
+        if z.dtype.kind == "f" and self.nodata is not None and not math.isnan(self.nodata):
+            z[z == self.nodata] = np.nan
+        conf = None
+        if self.confidence is not None:
+            if self.same_grid:
+                conf, _, _ = read_raster(self.confidence, 1, (r0, c0, nr, nc))
+            else:
+                conf = read_onto_grid(self.confidence, self.grid.window(r0, c0, nr, nc))
+            conf = np.nan_to_num(conf.astype(np.float64), nan=0.0)
+        return z, conf
+
+    def identity(self) -> list:
+        """What the windows depend on (part of the tile cache keys): files (path, size, mtime), band."""
+        return [
+            "dsm-filter-files",
+            list(file_identity(self.path)),
+            self.band,
+            self.nodata,
+            None if self.confidence is None else list(file_identity(self.confidence)),
+            self.same_grid,
+        ]
+
+
+@dataclass(frozen=True)
+class ArrayReader:
+    """Windows of arrays held in memory (:func:`filter_dsm_array`; in-process only, never cached)."""
+
+    z: np.ndarray  # float64, NaN = nodata
+    confidence: np.ndarray | None  # float64 in [0, 1], NaN already 0
+
+    def __call__(self, r0: int, c0: int, nr: int, nc: int) -> tuple[np.ndarray, np.ndarray | None]:
+        c = self.confidence
+        return self.z[r0 : r0 + nr, c0 : c0 + nc], (None if c is None else c[r0 : r0 + nr, c0 : c0 + nc])
+
+
+@dataclass(frozen=True)
+class FilterContext:
+    """What every tile task of a run shares (shipped once per pass to a cluster)."""
+
+    reader: FileReader | ArrayReader
+    grid: RasterGrid
+    config: DsmFilterConfig
+
+
+@dataclass(frozen=True)
+class Pass1Task:
+    """Outliers and hole labels of one tile core, computed on ``outer`` (core + margin)."""
+
+    core: tuple[int, int, int, int]
+    outer: tuple[int, int, int, int]
+
+    def key(self, base: str) -> str:
+        return Digest(base, "dsm-filter-pass1", list(self.core), list(self.outer)).hexdigest()
+
+
+@dataclass(frozen=True)
+class Pass2Task:
+    """Hole filling and smoothing of one tile core; ``small[l - 1]`` tells whether the merged
+    component of the core's hole label ``l`` (pass 1) is small enough to be filled."""
+
+    core: tuple[int, int, int, int]
+    outer: tuple[int, int, int, int]
+    small: np.ndarray  # (holes of the core,) bool
+
+    def key(self, base: str) -> str:
+        return Digest(
+            base, "dsm-filter-pass2", list(self.core), list(self.outer), np.asarray(self.small, bool)
+        ).hexdigest()
+
+
+#: part of every tile cache key: bump when the arithmetic of the tile tasks changes
+CACHE_VERSION = "dsm-filter-1"
+#: bytes per cell of a task's outer window (module docstring, "Parallel execution")
+TASK_BYTES_PER_CELL = 8 * 8 + 32
+#: largest size of the filtered cores held by this process between two writes (pass 2 batches)
+WRITE_BATCH_BYTES = 256 << 20
+
+
+def task_memory(rows: int, cols: int) -> int:
+    """Bytes one tile task needs at most for an outer window of ``rows x cols`` cells."""
+    return int(rows) * int(cols) * TASK_BYTES_PER_CELL
+
+
+def _read_padded(read, outer: tuple[int, int, int, int]):
     z, c = read(*outer)
     return np.ascontiguousarray(z, dtype=np.float64), (
         None if c is None else np.ascontiguousarray(c, dtype=np.float64)
     )
 
 
-def _run(
-    read: Reader,
-    write: Writer,
-    grid: RasterGrid,
-    cfg: DsmFilterConfig,
-    has_conf: bool,
-    progress: Progress | None,
-) -> FilterStats:
+def filter_pass1_task(ctx: FilterContext, task: Pass1Task) -> tuple[np.ndarray, ...]:
+    """Pass 1 of one tile: low-confidence, sharpening and outlier stages, hole labels of the core.
+
+    Returns ``(counts, width, size, top, bottom, left, right)``: ``counts`` = int64 [valid input,
+    outliers, low confidence, sharpened] over the core; per hole label ``l = 1..k`` of the core
+    (4-connected) its largest width (cells, float64) and its cell count (int64); the labels of
+    the core's four border lines (int32).
+    """
     from scipy import ndimage
 
+    cfg = ctx.config
+    res = ctx.grid.res
+    z, conf = _read_padded(ctx.reader, task.outer)
+    valid_in = np.isfinite(z)
+    clean, out_mask, low, sharp = _clean(z, conf, cfg, res)
+    sl = _inner(task.core, task.outer)
+    counts = np.array(
+        [int(valid_in[sl].sum()), int(out_mask[sl].sum()), int(low[sl].sum()), int(sharp[sl].sum())],
+        np.int64,
+    )
+    nodata = ~np.isfinite(clean)
+    width = _hole_width(nodata)
+    labels, k = ndimage.label(nodata[sl], structure=_FOUR)
+    if k:
+        idx = np.arange(1, k + 1)
+        wmax = np.asarray(ndimage.maximum(width[sl], labels, idx), np.float64)
+        sizes = np.asarray(ndimage.sum_labels(np.ones_like(labels), labels, idx)).astype(np.int64)
+    else:
+        wmax = np.zeros(0, np.float64)
+        sizes = np.zeros(0, np.int64)
+    borders = (labels[0], labels[-1], labels[:, 0], labels[:, -1])
+    return (counts, wmax, sizes, *(np.ascontiguousarray(b, np.int32) for b in borders))
+
+
+def filter_pass2_task(ctx: FilterContext, task: Pass2Task) -> tuple[np.ndarray, np.ndarray]:
+    """Pass 2 of one tile: the same cleaning, the small holes filled, smoothing.
+
+    Returns ``(core, counts)``: the filtered core (float32, NaN = nodata) and int64 [smoothed,
+    valid output] over the core.
+    """
+    from scipy import ndimage
+
+    cfg = ctx.config
+    res = ctx.grid.res
+    hole_cells = cfg.hole_cells(res)
+    z, conf = _read_padded(ctx.reader, task.outer)
+    clean, _, _, _ = _clean(z, conf, cfg, res)
+    sl = _inner(task.core, task.outer)
+    nodata = ~np.isfinite(clean)
+    core_labels, k = ndimage.label(nodata[sl], structure=_FOUR)
+    fill = np.zeros(nodata.shape, bool)
+    reach = np.zeros(nodata.shape, np.int32)
+    if k and cfg.max_hole > 0:
+        n = len(task.small)
+        small = np.array([False] + [bool(s) for s in task.small])
+        width_c = np.array([0] + [max(hole_cells, 1)] * n)
+        core_fill = small[core_labels]
+        # every window hole connected to a small core hole is the same (small) hole
+        wl, _ = ndimage.label(nodata, structure=_FOUR)
+        seed_labels = np.unique(wl[sl][core_fill])
+        seed_labels = seed_labels[seed_labels > 0]
+        fill = np.isin(wl, seed_labels)
+        # reach of the wall-top rule for each window hole (max_hole; per hole for future use)
+        lab_reach = np.zeros(int(wl.max()) + 1, np.int32)
+        np.maximum.at(lab_reach, wl[sl][core_fill], width_c[core_labels][core_fill])
+        reach = lab_reach[wl]
+    filled = _fill_holes(clean, fill, cfg.step, reach, z) if fill.any() else clean
+    smoothed = 0
+    if cfg.smooth:
+        out, changed = _smooth(filled, cfg, res)
+        smoothed = int(changed[sl].sum())
+        filled = out
+    core = filled[sl]
+    counts = np.array([smoothed, int(np.isfinite(core).sum())], np.int64)
+    return np.ascontiguousarray(core, np.float32), counts
+
+
+# ------------------------------------------------------------------ pipeline
+
+Writer = Callable[[np.ndarray, tuple[int, int, int, int]], None]
+
+
+def _run(
+    ctx: FilterContext,
+    write: Writer,
+    executor: Executor,
+    cache: TileCache | None,
+    progress: Progress | None,
+) -> FilterStats:
+    from ..progress import SubProgress
+
+    grid, cfg = ctx.grid, ctx.config
     res = grid.res
     steps = Steps(as_progress(progress), [1, 2])
     om = cfg.outlier_margin()
     hole_cells = cfg.hole_cells(res)
     margin1 = om + hole_cells // 2 + 2
-    n_labels: list[int] = []
     stats = FilterStats(cells=grid.rows * grid.cols)
-    comps = _Components()
+    base = ""
+    if cache is not None:
+        base = Digest(
+            CACHE_VERSION,
+            ctx.reader.identity() if isinstance(ctx.reader, FileReader) else None,
+            [grid.x_min, grid.y_max, grid.res, grid.rows, grid.cols, grid.crs],
+            asdict(cfg),
+        ).hexdigest()
     tiles = grid.tiles(cfg.tile, 0)
-    bases: list[int] = []
-    borders: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] = []
     # pass 1: outliers, hole labels per core, border labels
-    for n, t in enumerate(tiles):
-        check(steps.parent)
-        outer = _grow(t.core, margin1, grid)
-        z, conf = _read_padded(read, grid, outer)
-        valid_in = np.isfinite(z)
-        clean, out_mask, low, sharp = _clean(z, conf, cfg, res)
-        sl = _inner(t.core, outer)
-        stats.valid_input += int(valid_in[sl].sum())
-        stats.outliers_removed += int(out_mask[sl].sum())
-        stats.low_confidence_removed += int(low[sl].sum())
-        stats.sharpened += int(sharp[sl].sum())
-        nodata = ~np.isfinite(clean)
-        width = _hole_width(nodata)
-        core_nd = nodata[sl]
-        labels, k = ndimage.label(core_nd, structure=_FOUR)
+    tasks1 = [Pass1Task(t.core, _grow(t.core, margin1, grid)) for t in tiles]
+    results1 = executor.map_tiles(
+        filter_pass1_task,
+        tasks1,
+        steps[0],
+        shared=ctx,
+        cache=cache,
+        key=(lambda t: t.key(base)) if cache is not None else None,
+        label="DSM filter: outliers and holes",
+        memory=task_memory(*_largest(tasks1)),
+    )
+    comps = _Components()
+    bases: list[int] = []
+    n_labels: list[int] = []
+    borders: list[tuple[np.ndarray, ...]] = []
+    for counts, wmax, sizes, *border in results1:
+        stats.valid_input += int(counts[0])
+        stats.outliers_removed += int(counts[1])
+        stats.low_confidence_removed += int(counts[2])
+        stats.sharpened += int(counts[3])
+        k = len(wmax)
         if k:
-            idx = np.arange(1, k + 1)
-            wmax = ndimage.maximum(width[sl], labels, idx)
-            sizes = ndimage.sum_labels(np.ones_like(labels), labels, idx)
-            deep = np.asarray(wmax) * res > cfg.max_hole + 1e-9
-            base = comps.add(deep, np.asarray(sizes), np.asarray(wmax) * res)
+            base_k = comps.add(wmax * res > cfg.max_hole + 1e-9, sizes, wmax * res)
         else:
-            base = len(comps.parent)
-        bases.append(base - 1)  # local label l -> base - 1 + l
+            base_k = len(comps.parent)
+        bases.append(base_k - 1)  # local label l -> base - 1 + l
         n_labels.append(k)
-        borders.append((labels[0].copy(), labels[-1].copy(), labels[:, 0].copy(), labels[:, -1].copy()))
-        steps[0].update((n + 1) / len(tiles), f"DSM filter: outliers and holes, tile {n + 1}/{len(tiles)}")
+        borders.append(tuple(border))
+    del results1
     # merge labels across tile borders
     index = {tt.index: i for i, tt in enumerate(tiles)}
     for i, t in enumerate(tiles):
@@ -714,43 +935,44 @@ def _run(
     # pass 2: recompute, fill the small holes, smooth, write the cores. The margin of a tile with
     # small holes touching its core covers 1.5 times the widest of them (the interpolation) plus
     # the reach of the wall-top rule (max_hole), so the result does not depend on the tiles
+    tasks2: list[Pass2Task] = []
     for n, t in enumerate(tiles):
-        check(steps.parent)
         roots_t = [comps.find(bases[n] + lab) for lab in range(1, n_labels[n] + 1)]
         small_w = [comps.width[rt] for rt in roots_t if not comps.deep[rt]]
         w_cells = int(math.ceil(max(small_w) / res)) + 2 if (small_w and cfg.max_hole > 0) else 0
         margin2 = om + ((3 * w_cells) // 2 + hole_cells if w_cells else 0) + cfg.smooth_radius + 4
-        outer = _grow(t.core, margin2, grid)
-        z, conf = _read_padded(read, grid, outer)
-        clean, _, _, _ = _clean(z, conf, cfg, res)
-        sl = _inner(t.core, outer)
-        nodata = ~np.isfinite(clean)
-        core_labels, k = ndimage.label(nodata[sl], structure=_FOUR)
-        fill = np.zeros(nodata.shape, bool)
-        reach = np.zeros(nodata.shape, np.int32)
-        if k and cfg.max_hole > 0:
-            small = np.array([False] + [not comps.deep[rt] for rt in roots_t])
-            width_c = np.array([0] + [max(hole_cells, 1)] * len(roots_t))
-            core_fill = small[core_labels]
-            # every window hole connected to a small core hole is the same (small) hole
-            wl, _ = ndimage.label(nodata, structure=_FOUR)
-            seed_labels = np.unique(wl[sl][core_fill])
-            seed_labels = seed_labels[seed_labels > 0]
-            fill = np.isin(wl, seed_labels)
-            # reach of the wall-top rule for each window hole (max_hole; per hole for future use)
-            lab_reach = np.zeros(int(wl.max()) + 1, np.int32)
-            np.maximum.at(lab_reach, wl[sl][core_fill], width_c[core_labels][core_fill])
-            reach = lab_reach[wl]
-        filled = _fill_holes(clean, fill, cfg.step, reach, z) if fill.any() else clean
-        if cfg.smooth:
-            smoothed, changed = _smooth(filled, cfg, res)
-            stats.smoothed += int(changed[sl].sum())
-            filled = smoothed
-        core = filled[sl]
-        stats.valid_output += int(np.isfinite(core).sum())
-        write(core, t.core)
-        steps[1].update((n + 1) / len(tiles), f"DSM filter: filling, tile {n + 1}/{len(tiles)}")
+        small = np.array([not comps.deep[rt] for rt in roots_t], bool)
+        tasks2.append(Pass2Task(t.core, _grow(t.core, margin2, grid), small))
+    # batches of tiles whose cores this process holds before writing them (bounded memory)
+    per_batch = max(1, WRITE_BATCH_BYTES // (4 * cfg.tile * cfg.tile))
+    for start in range(0, len(tasks2), per_batch):
+        batch = tasks2[start : start + per_batch]
+        stop = start + len(batch)
+        label = "DSM filter: filling"
+        if len(batch) < len(tasks2):
+            label += f" (tiles {start + 1}-{stop} of {len(tasks2)})"
+        results2 = executor.map_tiles(
+            filter_pass2_task,
+            batch,
+            SubProgress(steps[1], start / len(tasks2), stop / len(tasks2)),
+            shared=ctx,
+            cache=cache,
+            key=(lambda t: t.key(base)) if cache is not None else None,
+            label=label,
+            memory=task_memory(*_largest(batch)),
+        )
+        for task, (core, counts) in zip(batch, results2, strict=True):
+            stats.smoothed += int(counts[0])
+            stats.valid_output += int(counts[1])
+            write(core, task.core)
+        del results2
     return stats
+
+
+def _largest(tasks) -> tuple[int, int]:
+    """(rows, cols) of the largest outer window of ``tasks`` (for their memory estimate)."""
+    t = max(tasks, key=lambda t: t.outer[2] * t.outer[3])
+    return t.outer[2], t.outer[3]
 
 
 def _grow(core: tuple[int, int, int, int], margin: int, grid: RasterGrid) -> tuple[int, int, int, int]:
@@ -782,7 +1004,7 @@ def filter_dsm_array(
     config: DsmFilterConfig | None = None,
     progress: Progress | None = None,
 ) -> tuple[np.ndarray, FilterStats]:
-    """Filter a DSM held in memory (same tiling as :func:`filter_dsm`).
+    """Filter a DSM held in memory (same tiling and tile tasks as :func:`filter_dsm`, in this process).
 
     Parameters
     ----------
@@ -807,14 +1029,12 @@ def filter_dsm_array(
         c = np.nan_to_num(_check_array("confidence", confidence, grid).astype(np.float64), nan=0.0)
     out = np.full(grid.shape, np.nan, np.float32)
 
-    def read(r0, c0, nr, nc):
-        return a[r0 : r0 + nr, c0 : c0 + nc], (None if c is None else c[r0 : r0 + nr, c0 : c0 + nc])
-
     def write(data, core):
         r0, c0, nr, nc = core
         out[r0 : r0 + nr, c0 : c0 + nc] = data
 
-    stats = _run(read, write, grid, cfg, c is not None, progress)
+    ctx = FilterContext(ArrayReader(a, c), grid, cfg)
+    stats = _run(ctx, write, InProcessExecutor(), None, progress)
     return out, stats
 
 
@@ -824,6 +1044,8 @@ def filter_dsm(
     confidence_path=None,
     config: DsmFilterConfig | None = None,
     progress: Progress | None = None,
+    executor: Executor | None = None,
+    cache_dir=None,
 ) -> FilterStats:
     """Filter a DSM GeoTIFF by tiles into a new GeoTIFF (atomic; CRS, grid and nodata kept).
 
@@ -837,6 +1059,12 @@ def filter_dsm(
         Confidence raster in [0, 1] (OSGM's CONFIDENCE); resampled onto the DSM grid when
         its grid differs.
     config : DsmFilterConfig, optional
+    executor : truortho.core.parallel.Executor, optional
+        Where the tile tasks run (module docstring, "Parallel execution"); default in this
+        process. Not closed here.
+    cache_dir : str or os.PathLike, optional
+        Keep every finished tile task there (:class:`~truortho.core.parallel.TileCache`) and
+        reuse it on a rerun with the same input files and parameters.
 
     Raises
     ------
@@ -846,7 +1074,7 @@ def filter_dsm(
         Every cell of the DSM is nodata, or a bad parameter.
     """
     from ..geometry.frame import parse_crs, require_metric
-    from ..rasterio_io import RasterWriter, raster_grid, read_onto_grid, read_raster
+    from ..rasterio_io import RasterWriter, raster_grid, read_raster
 
     cfg = config or DsmFilterConfig()
     cfg.validate()
@@ -863,20 +1091,16 @@ def filter_dsm(
             and parse_crs(cgrid.crs) == parse_crs(grid.crs)
         )
     _require_some_data(input_path, grid)
-
-    def read(r0, c0, nr, nc):
-        z, _, _ = read_raster(input_path, 1, (r0, c0, nr, nc))
-        z = z.astype(np.float64)
-        if z.dtype.kind == "f" and nodata is not None and not math.isnan(nodata):
-            z[z == nodata] = np.nan
-        conf = None
-        if confidence_path is not None:
-            if same_grid:
-                conf, _, _ = read_raster(confidence_path, 1, (r0, c0, nr, nc))
-            else:
-                conf = read_onto_grid(confidence_path, grid.window(r0, c0, nr, nc))
-            conf = np.nan_to_num(conf.astype(np.float64), nan=0.0)
-        return z, conf
+    reader = FileReader(
+        os.path.abspath(os.fspath(input_path)),
+        1,
+        None if nodata is None else float(nodata),
+        None if confidence_path is None else os.path.abspath(os.fspath(confidence_path)),
+        bool(same_grid),
+        grid,
+    )
+    ctx = FilterContext(reader, grid, cfg)
+    cache = TileCache(cache_dir) if cache_dir is not None else None
 
     with RasterWriter(
         output_path, grid, bands=1, dtype="float32", nodata=out_nodata, descriptions=["filtered DSM height"]
@@ -885,7 +1109,7 @@ def filter_dsm(
         def write(data, core):
             w.write(np.where(np.isfinite(data), data, out_nodata).astype(np.float32), core)
 
-        stats = _run(read, write, grid, cfg, confidence_path is not None, progress)
+        stats = _run(ctx, write, executor if executor is not None else InProcessExecutor(), cache, progress)
     return stats
 
 

@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import json
+import os
 
 from qgis.core import (
     QgsProcessingOutputNumber,
     QgsProcessingOutputString,
     QgsProcessingParameterBoolean,
+    QgsProcessingParameterEnum,
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterRasterLayer,
+    QgsProcessingParameterString,
 )
 
 from ..feedback import FeedbackProgress, core_errors
@@ -47,6 +50,8 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
     DTM_RESOLUTION = "DTM_RESOLUTION"
     MAX_WINDOW = "MAX_WINDOW"
     SLOPE = "SLOPE"
+    EXECUTOR = "EXECUTOR"
+    SCHEDULER_ADDRESS = "SCHEDULER_ADDRESS"
     OUTPUT = "OUTPUT"
     DTM = "DTM"
     NDSM = "NDSM"
@@ -54,6 +59,8 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
     OUTLIERS_REMOVED = "OUTLIERS_REMOVED"
     CELLS_FILLED = "CELLS_FILLED"
     HOLES_REMAINING = "HOLES_REMAINING"
+
+    EXECUTOR_CHOICES = ["inprocess", "local", "scheduler"]
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         num = QgsProcessingParameterNumber
@@ -146,6 +153,33 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
             num(self.SLOPE, tr("Ground filter slope (rise/run)"), num.Double, 0.15, minValue=0.001),
             advanced=True,
         )
+        self.add(
+            QgsProcessingParameterEnum(
+                self.EXECUTOR,
+                tr("Run tiles on"),
+                options=[
+                    tr("inprocess: this process (all cores)"),
+                    tr("local: a Dask cluster of worker processes on this computer"),
+                    tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
+                ],
+                defaultValue=0,
+            ),
+            advanced=True,
+        )
+        from ...core.parallel import SCHEDULER_ENV
+
+        self.add(
+            QgsProcessingParameterString(
+                self.SCHEDULER_ADDRESS,
+                tr(
+                    "Dask scheduler address (tls://host:port or scheduler file; "
+                    "empty = TRUORTHO_DASK_SCHEDULER)"
+                ),
+                defaultValue=os.environ.get(SCHEDULER_ENV, ""),
+                optional=True,
+            ),
+            advanced=True,
+        )
         self.add(QgsProcessingParameterRasterDestination(self.OUTPUT, tr("Filtered DSM")))
         self.add(
             QgsProcessingParameterRasterDestination(
@@ -164,6 +198,7 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
 
     @core_errors()
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 - QGIS API
+        from ...core.parallel import make_executor
         from ...core.progress import Steps
         from ...core.surface.dtm import DtmConfig, dtm_from_dsm
         from ...core.surface.filter import DsmFilterConfig, filter_dsm
@@ -188,9 +223,23 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
             smooth_radius=self.parameterAsInt(parameters, self.SMOOTH_RADIUS, context),
             smooth_tolerance=_optional_number(self, parameters, self.SMOOTH_TOLERANCE, context),
         )
+        address = (self.parameterAsString(parameters, self.SCHEDULER_ADDRESS, context) or "").strip()
+        executor = make_executor(
+            self.EXECUTOR_CHOICES[self.parameterAsEnum(parameters, self.EXECUTOR, context)], address or None
+        )
         progress = FeedbackProgress(feedback)
         steps = Steps(progress, [3, 1 if (dtm or ndsm) else 0])
-        stats = filter_dsm(src.source(), out, conf.source() if conf is not None else None, cfg, steps[0])
+        try:
+            stats = filter_dsm(
+                src.source(),
+                out,
+                conf.source() if conf is not None else None,
+                cfg,
+                steps[0],
+                executor=executor,
+            )
+        finally:
+            executor.close()
         feedback.pushInfo(stats.summary())
         if stats.holes_remaining:
             feedback.pushWarning(
@@ -206,7 +255,6 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
                 max_window=self.parameterAsDouble(parameters, self.MAX_WINDOW, context),
                 slope=self.parameterAsDouble(parameters, self.SLOPE, context),
             )
-            import os
             import tempfile
 
             target = dtm

@@ -296,6 +296,19 @@ HELP: dict[str, dict] = {
             "MAX_WINDOW": "Largest opening radius of the ground filter, metres: more than half the width of "
             "the largest building.",
             "SLOPE": "Terrain slope (rise over run) the ground filter keeps as ground.",
+            "EXECUTOR": "Where the tiles are filtered; the filtered DSM and the statistics are identical "
+            "with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the "
+            "default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 "
+            "only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given "
+            "by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same "
+            "paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles "
+            "recomputed by the others. The terrain model is computed in QGIS's process.",
+            "SCHEDULER_ADDRESS": "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
+            "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
+            "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
+            "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
+            "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
+            "that is not on this computer is refused.",
             "OUTPUT": "Filtered DSM (GeoTIFF, float32).",
             "DTM": "Optional terrain model (GeoTIFF, float32, DSM grid).",
             "NDSM": "Optional normalised DSM: DSM minus DTM, heights above the terrain.",

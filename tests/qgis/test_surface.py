@@ -58,6 +58,7 @@ def test_dsmfilter_with_dtm(truortho_provider, rasters, tmp_path):
             "OUTPUT": str(tmp_path / "filtered.tif"),
             "DTM": str(tmp_path / "dtm.tif"),
             "NDSM": str(tmp_path / "ndsm.tif"),
+            "EXECUTOR": 0,  # inprocess (the default), explicitly
         },
     )
     stats = json.loads(res["STATISTICS"])
@@ -76,6 +77,21 @@ def test_dsmfilter_with_dtm(truortho_provider, rasters, tmp_path):
     for key in ("DTM", "NDSM"):
         assert raster_grid(res[key]) == grid
     assert "dtm" in stats and stats["dtm"]["ground_fraction"] > 0.5
+
+
+def test_dsmfilter_refuses_an_unauthenticated_remote_scheduler(truortho_provider, rasters, tmp_path):
+    from qgis.core import QgsProcessingException
+
+    root = rasters[0]
+    params = {
+        "INPUT": str(root / "raw.tif"),
+        "OUTPUT": str(tmp_path / "filtered.tif"),
+        "EXECUTOR": 2,
+        "SCHEDULER_ADDRESS": "tcp://198.51.100.7:8786",
+    }
+    with pytest.raises(QgsProcessingException, match="unauthenticated"):
+        run("truortho:dsmfilter", params)
+    assert not any(tmp_path.iterdir())
 
 
 def test_mesh_from_dsm_for_trueortho(truortho_provider, rasters, tmp_path):
