@@ -39,15 +39,26 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import CRSError, InputError, MissingFileError
+from ..errors import CancelledError, CRSError, InputError, MissingFileError
 from ..grid import RasterGrid
 from ..imagery import image_info
 from ..orientation import Orientation, as_orientation
-from ..progress import Progress, Steps, as_progress, check
+from ..parallel import Digest, TileCache, file_identity
+from ..progress import Progress, Steps, SubProgress, as_progress, check
 from .color import ColorCorrection, estimate_corrections, to_channels
-from .mosaic import ImageStore, MosaicParams, candidate_colours, mosaic_tile, to_dtype
+from .mosaic import ImageStore, MosaicParams, candidate_colours
 from .seams import dissolve, region_polygons
 from .surface import PlanTransform, open_surface, same_crs, transform_bounds
+from .tiles import (
+    OrthoContext,
+    OrthoTask,
+    candidates_bound,
+    fixed_labels,
+    ortho_tile_task,
+    side_of,
+    task_memory,
+    waves,
+)
 from .views import HeightBlocks, prepare_views, tile_views
 from .zbuffer import occluder_wall_min
 
@@ -106,6 +117,17 @@ class TrueOrthoConfig:
         Threads for the per-image depth buffers of a tile.
     cog : bool
         Cloud-Optimized GeoTIFF layout (with overviews) for the rasters.
+    executor : {"inprocess", "local", "scheduler"}
+        Where the mosaic tiles run (:mod:`truortho.core.parallel`; the colour statistics, on a
+        decimated grid, always run here). Tiles run in waves (:mod:`.tiles`); the mosaic is
+        bit-identical on every backend.
+    scheduler_address : str, optional
+        Dask scheduler of ``executor="scheduler"`` (default ``$TRUORTHO_DASK_SCHEDULER``).
+    dask_workers : int, optional
+        Worker processes of ``executor="local"`` (default the cores).
+    cache_dir : path, optional
+        Keep finished tiles there (content-addressed) and reuse them on a rerun; default a
+        scratch folder beside the output (``<output>.tiles``), removed after success.
     """
 
     resolution: float | None = None
@@ -130,6 +152,10 @@ class TrueOrthoConfig:
     color_cells: int = 60_000
     workers: int = 2
     cog: bool = True
+    executor: str = "inprocess"
+    scheduler_address: str | None = None
+    dask_workers: int | None = None
+    cache_dir: str | os.PathLike | None = None
 
     def validate(self) -> None:
         def bad(name, why):
@@ -157,6 +183,10 @@ class TrueOrthoConfig:
                 bad(name, "must not be negative")
         if self.extent is not None and len(self.extent) != 4:
             bad("extent", "expected (xmin, ymin, xmax, ymax)")
+        from ..parallel import EXECUTORS
+
+        if self.executor not in EXECUTORS:
+            bad("executor", f"expected one of {', '.join(EXECUTORS)}")
 
 
 @dataclass
@@ -212,6 +242,7 @@ def true_ortho(
     config: TrueOrthoConfig | None = None,
     progress: Progress | None = None,
     image_root: str | os.PathLike | None = None,
+    executor=None,
 ) -> TrueOrthoResult:
     """Compute a true orthophoto.
 
@@ -231,6 +262,8 @@ def true_ortho(
         Reports per tile; cancelling leaves no output.
     image_root : path, optional
         Overrides the orientation's image folder.
+    executor : :class:`~truortho.core.parallel.Executor`, optional
+        Where the tiles run; default one made from ``config.executor`` (closed at the end).
 
     Returns
     -------
@@ -379,15 +412,28 @@ def true_ortho(
     t0 = time.perf_counter()
     overlap = max(cfg.blend_width, 4) + 8
     tiles = grid.tiles(cfg.tile_size, overlap)
+    own_executor = executor is None
+    if executor is None:
+        from ..parallel import make_executor
+
+        executor = make_executor(cfg.executor, cfg.scheduler_address, n_workers=cfg.dask_workers)
+    cache = None
+    if cfg.cache_dir is not None:
+        cache = TileCache(cfg.cache_dir)
+    else:  # scratch tiles: a rerun after a crash resumes from them; removed after success
+        cache = TileCache(f"{os.fspath(output)}.tiles", remove_when_done=True)
+    stats["executor"] = getattr(executor, "name", type(executor).__name__)
     sub = steps[2]
     parts: dict[int, list] = {}
     counts = np.zeros(len(o.images), np.int64)
     n_seen = n_valid = n_occl = n_samples = 0
     out_path = Path(os.fspath(output))
     names = [f"band {k + 1}" for k in range(bands)] + ["alpha"]
-    amax = np.iinfo(dtype).max if dtype.kind in "ui" else 1.0
     with contextlib.ExitStack() as stack:
         from ..rasterio_io import RasterWriter
+
+        if own_executor:
+            stack.callback(executor.close)
 
         w_out = stack.enter_context(
             RasterWriter(
@@ -434,43 +480,80 @@ def true_ortho(
                 )
             )
         tri_max = 0
-        done: dict[tuple[int, int], tuple] = {}  # labels of the cores of the previous and current tile row
-        for n, tile in enumerate(tiles):
+        done: dict[tuple[int, int], tuple] = {}  # core window and labels of finished tiles
+        ctx = OrthoContext(
+            setup,
+            surf,
+            grid,
+            to_local,
+            tuple(paths),
+            tuple((int(sw), int(sh)) for sw, sh in sizes),
+            bands,
+            dtype.name,
+            cfg.image_cache_mb << 20,
+            correction,
+            params,
+            workers,
+            store=store,
+        )
+        memory = task_memory(
+            side_of(cfg.tile_size, overlap),
+            setup.margin_cells,
+            candidates_bound(setup, grid, side_of(cfg.tile_size, overlap)),
+            bands,
+            cfg.image_cache_mb << 20,
+        )
+        stats["task_memory_mb"] = round(memory / 2**20, 1)
+        base = ""
+        if cache is not None:
+            base = _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs)
+        n_done = 0
+        tile_cols = 1 + max(t.index[1] for t in tiles)
+        for w, wave in enumerate(waves(tiles)):
             check(progress)
-            fixed = _fixed_labels(tile, done)
-            prefer = np.unique(fixed[fixed >= 0])
-            views = tile_views(setup, surf, grid, tile, to_local, workers, prefer=prefer)
-            tri_max = max(tri_max, views.triangles)
-            if len(views.cands):
-                isl = tile.inner_slices
-                n_samples += int(views.usable[:, isl[0], isl[1]].sum())
-            m = mosaic_tile(views, store, correction, res, params, fixed)
-            sl = tile.inner_slices
-            vals = to_dtype(m.values[:, sl[0], sl[1]], dtype)
-            alpha = m.alpha[sl]
-            vals[:, ~alpha] = 0
-            a = np.where(alpha, amax, 0).astype(dtype)
-            w_out.write(np.concatenate([vals, a[None]], axis=0), tile.core)
-            lab = m.label[sl]
-            done[tile.index] = (tile.core, lab.astype(np.int16))
-            for key in [k for k in done if k[0] < tile.index[0] - 1]:
+            tasks = [OrthoTask(t, fixed_labels(t, done)) for t in wave]
+            wsub = SubProgress(sub, n_done / len(tiles), (n_done + len(wave)) / len(tiles))
+            try:
+                results = executor.map_tiles(
+                    ortho_tile_task,
+                    tasks,
+                    wsub,
+                    shared=ctx,
+                    cache=cache,
+                    key=(lambda t: t.key(base)) if cache is not None else None,
+                    label="true ortho",
+                    memory=memory,
+                )
+            except CancelledError:
+                raise CancelledError("true orthophoto cancelled") from None
+            for tile, (out_t, lab, occ, counters) in zip(wave, results, strict=True):
+                n_samples += int(counters[0])
+                tri_max = max(tri_max, int(counters[1]))
+                w_out.write(out_t, tile.core)
+                done[tile.index] = (tile.core, lab)
+                if w_idx is not None:
+                    w_idx.write(lab, tile.core)
+                if w_occ is not None:
+                    w_occ.write(occ, tile.core)
+                n_valid += int(np.count_nonzero(occ != 255))
+                n_occl += int(np.count_nonzero(occ == 1))
+                n_seen += int(np.count_nonzero(out_t[-1]))
+                ok = lab >= 0
+                counts += np.bincount(lab[ok], minlength=len(o.images))
+                for k, polys in region_polygons(lab, tile.core_grid(grid).transform).items():
+                    parts.setdefault(k, []).extend(polys)
+            n_done += len(wave)
+            # later waves need only the rows from their first row - 1 on
+            first_next = max(0, -(-(w + 1 - (tile_cols - 1)) // 2))
+            for key in [k for k in done if k[0] < first_next - 1]:
                 del done[key]
-            if w_idx is not None:
-                w_idx.write(lab.astype(np.int16), tile.core)
-            if w_occ is not None:
-                w_occ.write(m.occlusion[sl], tile.core)
-            occ = m.occlusion[sl]
-            n_valid += int(np.count_nonzero(occ != 255))
-            n_occl += int(np.count_nonzero(occ == 1))
-            n_seen += int(np.count_nonzero(alpha))
-            ok = lab >= 0
-            counts += np.bincount(lab[ok], minlength=len(o.images))
-            for k, polys in region_polygons(lab, tile.core_grid(grid).transform).items():
-                parts.setdefault(k, []).extend(polys)
-            sub.update((n + 1) / len(tiles), f"tile {n + 1}/{len(tiles)}")
+            sub.update(n_done / len(tiles), f"tile {n_done}/{len(tiles)}")
         check(progress)
         steps[3].update(0.0, "writing overviews")
     stats["seconds_mosaic"] = round(time.perf_counter() - t0, 3)
+    if cache is not None:
+        stats["tile_cache"] = {"hits": cache.hits, "written": cache.written}
+        cache.finish()
     regions = [SeamRegion(k, o.images[k].name, int(counts[k]), g) for k, g in dissolve(parts).items()]
     stats.update(
         {
@@ -500,16 +583,41 @@ def true_ortho(
     )
 
 
-def _fixed_labels(tile, done: dict) -> np.ndarray:
-    """Labels already written in the tile's outer window by earlier tiles (-1 elsewhere)."""
-    r0, c0, nr, nc = tile.outer
-    out = np.full((nr, nc), -1, np.int64)
-    for (cr0, cc0, cnr, cnc), lab in done.values():
-        a0, a1 = max(r0, cr0), min(r0 + nr, cr0 + cnr)
-        b0, b1 = max(c0, cc0), min(c0 + nc, cc0 + cnc)
-        if a1 > a0 and b1 > b0:
-            out[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0] = lab[a0 - cr0 : a1 - cr0, b0 - cc0 : b1 - cc0]
-    return out
+#: Config fields that do not change the mosaic (left out of the tile cache keys).
+_NOT_IN_KEY = {
+    "executor",
+    "scheduler_address",
+    "dask_workers",
+    "cache_dir",
+    "workers",
+    "image_cache_mb",
+    "cog",
+}
+
+
+def _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs) -> str:
+    """Identity of a run's inputs and parameters: every tile key starts from it."""
+    import dataclasses
+
+    d = Digest("true-ortho", [file_identity(paths[i]) for i in relevant], out_crs, list(grid.geotransform))
+    d.add([grid.rows, grid.cols])
+    for im in o.images:
+        cam = o.camera_of(im)
+        d.add(
+            [np.asarray(im.R, np.float64), np.asarray(im.C, np.float64), np.asarray(cam.params, np.float64)]
+        )
+    d.add(np.asarray(o.offset, np.float64))
+    path = getattr(surf, "path", None)
+    if path and os.path.isfile(str(path)):
+        d.add(file_identity(path))
+    elif hasattr(surf, "h"):
+        d.add(np.asarray(surf.h))
+    elif hasattr(surf, "vertices"):
+        d.add([np.asarray(surf.vertices), np.asarray(surf.faces)])
+    d.add({k: v for k, v in dataclasses.asdict(cfg).items() if k not in _NOT_IN_KEY})
+    if correction is not None:
+        d.add([np.asarray(correction.gain), np.asarray(correction.offset), bool(correction.lab)])
+    return d.hexdigest()
 
 
 def _estimate_colour(

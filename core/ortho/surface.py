@@ -64,6 +64,13 @@ class PlanTransform:
                     f"CRS: no transformation from {_short(src_crs)} to {_short(dst_crs)} ({exc})"
                 ) from None
 
+    def __getstate__(self):
+        # pyproj transformers are rebuilt where the object is unpickled (a Dask worker)
+        return {"offset": self.offset, "src_crs": self.src_crs, "dst_crs": self.dst_crs}
+
+    def __setstate__(self, state) -> None:
+        self.__init__(state["src_crs"], state["dst_crs"], state["offset"])  # type: ignore[misc]
+
     @property
     def identity(self) -> bool:
         return self._tr is None

@@ -39,6 +39,9 @@ from ..jit import njit
 from .surface import PlanTransform
 from .zbuffer import frame_cells, project, render_depth, view_cells
 
+#: Candidates evaluated between two checks of the cells' clean views (``views_per_cell``).
+LAZY_BATCH = 2
+
 
 @dataclass
 class ViewSetup:
@@ -447,7 +450,7 @@ def tile_views(
     clean_count = np.zeros(rows * cols, np.int32)
     cells = vidx
     results_by: dict[int, tuple | None] = {}
-    batch = max(1, int(workers))
+    batch = LAZY_BATCH  # fixed, so the result does not depend on the threads
     pool = None
     if workers > 1 and len(order) > 1:
         from concurrent.futures import ThreadPoolExecutor

@@ -1,0 +1,142 @@
+"""Tile-parallel true orthophoto (core/ortho/tiles.py on core/parallel).
+
+Acceptance (issue 8, orthophoto part): in-process, a local Dask cluster of 2 worker processes and a
+scheduler started separately (``dask scheduler`` + ``dask worker`` on 127.0.0.1) give a bit-identical
+mosaic, source index and occlusion mask and the same seamline areas; a worker killed mid-run changes
+nothing; a rerun reuses the cached tiles and a run with other parameters reuses none.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+
+import numpy as np
+import pytest
+
+pytest.importorskip("cv2")
+pytest.importorskip("distributed")
+
+from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho  # noqa: E402
+from truortho.core.ortho.tiles import waves  # noqa: E402
+from truortho.core.parallel import SchedulerExecutor  # noqa: E402
+from truortho.core.progress import CallbackProgress  # noqa: E402
+from truortho.core.rasterio_io import read_raster  # noqa: E402
+from truortho.core.synthetic import SceneConfig, make_scene  # noqa: E402
+
+SCENE = dict(
+    extent=(-20.0, -15.0, 20.0, 15.0), n_buildings=2, building_size=(7.0, 11.0), building_gap=3.0,
+    tower=False, image_size=(240, 180), focal_px=300.0, n_oblique=0, seed=5,
+)  # fmt: skip
+RES, TILE = 0.25, 48  # 160 x 120 cells: 4 x 3 tiles in 8 waves
+
+
+@pytest.fixture(scope="module")
+def scene(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("parallel_ortho_scene")
+    sc = make_scene(SceneConfig(**SCENE))
+    sc.write(folder)
+    return sc, folder
+
+
+def _run(scene, out, executor=None, progress=None, **cfg):
+    sc, folder = scene
+    config = TrueOrthoConfig(resolution=RES, tile_size=TILE, extent=sc.extent_world(), **cfg)
+    return true_ortho(folder / "orientation.json", folder / "dsm.tif", out / "ortho.tif", out / "idx.tif",
+                      out / "occ.tif", config, progress=progress, executor=executor)  # fmt: skip
+
+
+def _products(out):
+    return tuple(read_raster(out / n, band=None)[0] for n in ("ortho.tif", "idx.tif", "occ.tif"))
+
+
+def _same(a, b) -> bool:
+    return all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
+
+
+@pytest.fixture(scope="module")
+def reference(scene, tmp_path_factory):
+    out = tmp_path_factory.mktemp("ortho_reference")
+    r = _run(scene, out)
+    assert r.stats["tiles"] == 12 and r.stats["executor"] == "inprocess"
+    assert r.stats["coverage"] > 0.95 and not (out / "ortho.tif.tiles").exists()
+    return _products(out), {s.image_index: round(s.geometry.area, 6) for s in r.seamlines}
+
+
+def test_waves_respect_the_neighbours_a_tile_continues():
+    from truortho.core.grid import RasterGrid
+
+    g = RasterGrid.from_extent((0, 0, 100, 80), 1.0, None)
+    tiles = g.tiles(16, 4)
+    order = {t.index: w for w, wave in enumerate(waves(tiles)) for t in wave}
+    assert sorted(order) == sorted(t.index for t in tiles)
+    for (i, j), w in order.items():
+        for nb in ((i - 1, j - 1), (i - 1, j), (i - 1, j + 1), (i, j - 1)):
+            if nb in order:
+                assert order[nb] < w, ((i, j), nb)
+    assert max(len(wv) for wv in waves(tiles)) >= 2  # some parallelism
+
+
+@pytest.mark.slow
+def test_local_cluster_gives_the_in_process_orthophoto(scene, reference, dask_cluster, tmp_path):
+    r = _run(scene, tmp_path, executor=dask_cluster)
+    assert r.stats["executor"] == "local"
+    assert _same(_products(tmp_path), reference[0])
+    assert {s.image_index: round(s.geometry.area, 6) for s in r.seamlines} == reference[1]
+
+
+@pytest.mark.slow
+def test_separate_scheduler_gives_the_in_process_orthophoto(scene, reference, dask_scheduler_file, tmp_path):
+    with SchedulerExecutor(dask_scheduler_file) as ex:
+        r = _run(scene, tmp_path, executor=ex)
+    assert r.stats["executor"] == "scheduler"
+    assert _same(_products(tmp_path), reference[0])
+
+
+@pytest.mark.slow
+def test_a_worker_killed_mid_run_changes_nothing(scene, reference, dask_cluster, tmp_path):
+    pids = dask_cluster.worker_pids()
+    killed = []
+
+    def on_update(fraction, message):
+        # a wave of two tiles has finished one: the other is running (or queued) on a worker
+        if not killed and message and "true ortho: tile 1/2" in message:
+            busy = [a for a, keys in dask_cluster.client.processing().items() if keys]
+            if busy and busy[0] in pids:
+                os.kill(pids[busy[0]], signal.SIGKILL)
+                killed.append(pids[busy[0]])
+
+    _run(scene, tmp_path, executor=dask_cluster, progress=CallbackProgress(on_update))
+    assert killed, "no worker was killed"
+    assert _same(_products(tmp_path), reference[0])
+
+
+def test_cache_reuses_tiles_of_the_same_run_only(scene, reference, tmp_path):
+    cache = tmp_path / "cache"
+    r1 = _run(scene, tmp_path / "a", cache_dir=cache)
+    assert r1.stats["tile_cache"] == {"hits": 0, "written": 12}
+    r2 = _run(scene, tmp_path / "b", cache_dir=cache, workers=1)  # threads are not part of the key
+    assert r2.stats["tile_cache"] == {"hits": 12, "written": 0}
+    assert _same(_products(tmp_path / "b"), reference[0])
+    r3 = _run(scene, tmp_path / "c", cache_dir=cache, blend_width=2)
+    assert r3.stats["tile_cache"]["hits"] == 0
+    assert not _same(_products(tmp_path / "c"), reference[0])
+
+
+def test_rerun_after_a_crash_resumes_from_the_finished_tiles(scene, reference, tmp_path):
+    seen = []
+
+    def on_update(fraction, message):
+        if message and "true ortho: tile" in message:
+            seen.append(message)
+            if len(seen) == 5:
+                raise RuntimeError("simulated crash")
+
+    with pytest.raises(RuntimeError, match="simulated crash"):
+        _run(scene, tmp_path, progress=CallbackProgress(on_update))
+    assert not (tmp_path / "ortho.tif").exists()
+    assert len(list((tmp_path / "ortho.tif.tiles").glob("*.npz"))) == 5
+    r = _run(scene, tmp_path)
+    assert r.stats["tile_cache"] == {"hits": 5, "written": 7}
+    assert _same(_products(tmp_path), reference[0])
+    assert not (tmp_path / "ortho.tif.tiles").exists()
