@@ -17,10 +17,17 @@
 
 Products have fixed names in the output folder (:data:`PRODUCTS`); every file
 is written atomically by its stage.
+
+The tiles of stages 2, 3 and 5 run on one executor (:mod:`truortho.core.parallel`,
+``WorkflowConfig.executor``: in this process, a local Dask cluster or a Dask
+scheduler), made once before the orientation (a bad choice or an unusable
+scheduler address fails before any work) and closed when the run ends, however
+it ends; a local cluster thus starts once for the three stages.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import resource
@@ -64,12 +71,21 @@ class WorkflowConfig:
         Interior orientation (held fixed), as for ``truortho:orientimages``.
     reuse_orientation : bool
         Skip the orientation when ``orientation.json`` exists in the output folder.
+    executor : {"inprocess", "local", "scheduler"}
+        Where the tiles of dense matching, the DSM filter and the true orthophoto run
+        (:func:`truortho.core.parallel.make_executor`); one executor serves the three stages and
+        overrides the stage configurations' own ``executor``/``scheduler_address``. A local
+        cluster takes its workers and memory limit from ``osgm.workers``/``osgm.worker_memory``.
+    scheduler_address : str, optional
+        Dask scheduler of ``executor="scheduler"`` (default ``$TRUORTHO_DASK_SCHEDULER``).
     orient, osgm, dsm_filter, mesh, ortho : stage configurations (defaults when None)
     """
 
     resolution: float | None = None
     camera_file: str | os.PathLike | None = None
     reuse_orientation: bool = False
+    executor: str = "inprocess"
+    scheduler_address: str | None = None
     orient: Any = None
     osgm: Any = None
     dsm_filter: Any = None
@@ -124,18 +140,57 @@ def run_workflow(
         Control and check points with their image measurements (world coordinates in ``crs``).
     crs : str, optional
         CRS of the GCPs and the products.
+
+    Raises
+    ------
+    InputError
+        Bad parameters (RESOLUTION, EXECUTOR, SCHEDULER_ADDRESS) before any work, or bad input.
     """
+    from .ortho.pipeline import TrueOrthoConfig
+    from .osgm import OsgmConfig
+    from .parallel import EXECUTORS, make_executor, parse_memory
+
+    cfg = config or WorkflowConfig()
+    if cfg.resolution is not None and not (np.isfinite(cfg.resolution) and cfg.resolution > 0):
+        raise InputError(f"RESOLUTION: expected a positive number of metres, got {cfg.resolution!r}")
+    if cfg.executor not in EXECUTORS:
+        raise InputError(f"EXECUTOR: expected one of {', '.join(EXECUTORS)}, got {cfg.executor!r}")
+    # the stages' configurations name the workflow's executor (their validation sees it); the
+    # caller's objects are not changed
+    ocfg = dataclasses.replace(
+        cfg.osgm or OsgmConfig(), executor=cfg.executor, scheduler_address=cfg.scheduler_address
+    )
+    if cfg.resolution is not None:
+        ocfg.resolution = float(cfg.resolution)
+    tcfg = dataclasses.replace(
+        cfg.ortho or TrueOrthoConfig(), executor=cfg.executor, scheduler_address=cfg.scheduler_address
+    )
+    ocfg.validate()
+    tcfg.validate()
+    # cheap: a local cluster starts on its first tiles, a scheduler is reached then (its address is
+    # checked here)
+    executor = make_executor(
+        cfg.executor,
+        cfg.scheduler_address,
+        n_workers=ocfg.workers,
+        memory_limit=parse_memory(ocfg.worker_memory),
+    )
+    try:
+        return _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress)
+    finally:
+        executor.close()
+
+
+def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) -> WorkflowResult:
+    """:func:`run_workflow` after its checks, on ``executor`` (closed by the caller)."""
     from .orientation import Orientation
-    from .ortho.pipeline import TrueOrthoConfig, true_ortho
-    from .osgm import OsgmConfig, OsgmOutputs, run_osgm
+    from .ortho.pipeline import true_ortho
+    from .osgm import OsgmOutputs, run_osgm
     from .sfm.pipeline import OrientConfig, orient_images
     from .surface.filter import DsmFilterConfig, filter_dsm
     from .surface.mesh import DsmMeshConfig, mesh_from_dsm
     from .surface.meshio import write_mesh
 
-    cfg = config or WorkflowConfig()
-    if cfg.resolution is not None and not (np.isfinite(cfg.resolution) and cfg.resolution > 0):
-        raise InputError(f"RESOLUTION: expected a positive number of metres, got {cfg.resolution!r}")
     folder = Path(output_folder)
     folder.mkdir(parents=True, exist_ok=True)
     paths = _paths(folder)
@@ -173,14 +228,11 @@ def run_workflow(
 
     # 2. OSGM
     stages.start("dense matching (OSGM)")
-    ocfg = cfg.osgm or OsgmConfig()
-    if cfg.resolution is not None:
-        ocfg.resolution = float(cfg.resolution)
     osgm = run_osgm(
         orientation, ocfg, None,
         OsgmOutputs(dsm=paths["dsm_raw"], confidence=paths["confidence"], orthoimage=paths["orthoimage"],
                     point_cloud=paths["pointcloud"]),
-        progress=steps[1],
+        progress=steps[1], executor=executor,
     )  # fmt: skip
     stages.stop(osgm.summary())
     res = osgm.stats["resolution"]
@@ -188,7 +240,9 @@ def run_workflow(
     # 3. DSM filter
     stages.start("DSM filter")
     fcfg = cfg.dsm_filter or DsmFilterConfig()
-    fstats = filter_dsm(paths["dsm_raw"], paths["dsm"], paths["confidence"], fcfg, progress=steps[2])
+    fstats = filter_dsm(
+        paths["dsm_raw"], paths["dsm"], paths["confidence"], fcfg, progress=steps[2], executor=executor
+    )
     stages.stop(fstats.summary())
 
     # 4. mesh
@@ -199,12 +253,11 @@ def run_workflow(
 
     # 5. true orthophoto
     stages.start("true orthophoto")
-    tcfg = cfg.ortho or TrueOrthoConfig()
     if tcfg.resolution is None:
         tcfg.resolution = res
     tres = true_ortho(
         orientation, paths["dsm"], paths["trueortho"], paths["source_index"], paths["occlusion"], tcfg,
-        steps[4],
+        steps[4], executor=executor,
     )  # fmt: skip
     write_seamlines(paths["seamlines"], tres.seamlines, tres.grid.crs)
     st = tres.stats
@@ -213,6 +266,8 @@ def run_workflow(
     # 6. report
     stages.start("report")
     _fill_report(report, orient_report, orientation, osgm, fstats, paths, tres, stages, reuse)
+    ran_on = executor.describe() if hasattr(executor, "describe") else type(executor).__name__
+    report.summary["tiles ran on"] = ran_on
     stages.stop()
     report.tables[-1].rows = stages.rows
     report.summary["total time [s]"] = round(time.perf_counter() - t0, 1)
@@ -225,6 +280,7 @@ def run_workflow(
         "trueortho": {k: v for k, v in st.items() if isinstance(v, int | float | str)},
         "filter": fstats.summary(),
         "peak_mb": max(r[2] for r in stages.rows),
+        "executor": ran_on,
     }
     progress.update(1.0, "pipeline done")
     return WorkflowResult(paths, stats, report)
@@ -271,9 +327,8 @@ def _previous_orientation_report(folder: Path) -> Report | None:
         if str(t.get("title", "")).startswith("Stage"):
             continue
         rep.tables.append(Table(t["title"], t["columns"], t["rows"], t.get("note", "")))
-    rep.summary = {
-        k: v for k, v in d.get("summary", {}).items() if not str(k).startswith(("DSM", "true", "total"))
-    }
+    this_run = ("DSM", "true", "total", "tiles")  # the rest of the chain, not the orientation
+    rep.summary = {k: v for k, v in d.get("summary", {}).items() if not str(k).startswith(this_run)}
     return rep
 
 

@@ -13,9 +13,11 @@ from qgis.core import (
     QgsProcessingOutputVectorLayer,
     QgsProcessingParameterBoolean,
     QgsProcessingParameterCrs,
+    QgsProcessingParameterEnum,
     QgsProcessingParameterFile,
     QgsProcessingParameterFolderDestination,
     QgsProcessingParameterNumber,
+    QgsProcessingParameterString,
 )
 
 from ..feedback import FeedbackProgress, core_errors
@@ -36,6 +38,8 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
     CRS = "CRS"
     RESOLUTION = "RESOLUTION"
     REUSE_ORIENTATION = "REUSE_ORIENTATION"
+    EXECUTOR = "EXECUTOR"
+    SCHEDULER_ADDRESS = "SCHEDULER_ADDRESS"
     OUTPUT_FOLDER = "OUTPUT_FOLDER"
     # outputs (files named in truortho.core.workflow.PRODUCTS)
     OUTPUTS = {
@@ -48,6 +52,8 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         "OCCLUSION": "occlusion",
         "SEAMLINES": "seamlines",
     }
+
+    EXECUTOR_CHOICES = ["inprocess", "local", "scheduler"]
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
@@ -76,6 +82,33 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
             QgsProcessingParameterBoolean(
                 self.REUSE_ORIENTATION, tr("Reuse an existing orientation.json in the output folder"), False
             )
+        )
+        self.add(
+            QgsProcessingParameterEnum(
+                self.EXECUTOR,
+                tr("Run tiles on"),
+                options=[
+                    tr("inprocess: this process (all cores)"),
+                    tr("local: a Dask cluster of worker processes on this computer"),
+                    tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
+                ],
+                defaultValue=0,
+            ),
+            advanced=True,
+        )
+        from ...core.parallel import SCHEDULER_ENV
+
+        self.add(
+            QgsProcessingParameterString(
+                self.SCHEDULER_ADDRESS,
+                tr(
+                    "Dask scheduler address (tls://host:port or scheduler file; "
+                    "empty = TRUORTHO_DASK_SCHEDULER)"
+                ),
+                defaultValue=os.environ.get(SCHEDULER_ENV, ""),
+                optional=True,
+            ),
+            advanced=True,
         )
         self.add(QgsProcessingParameterFolderDestination(self.OUTPUT_FOLDER, tr("Output folder")))
         names = {
@@ -127,10 +160,14 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         res = self.parameterAsDouble(parameters, self.RESOLUTION, context)
         if res < 0:
             raise QgsProcessingException(tr("RESOLUTION: expected a positive number of metres or 0"))
+        address = (self.parameterAsString(parameters, self.SCHEDULER_ADDRESS, context) or "").strip()
         cfg = WorkflowConfig(
             resolution=res if res > 0 else None,
             camera_file=self.parameterAsFile(parameters, self.CAMERA, context) or None,
             reuse_orientation=reuse,
+            # one executor for OSGM, the DSM filter and the true orthophoto (made and closed by run_workflow)
+            executor=self.EXECUTOR_CHOICES[self.parameterAsEnum(parameters, self.EXECUTOR, context)],
+            scheduler_address=address or None,
         )
         run = run_workflow(
             images,
@@ -142,6 +179,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         )
         for row in run.stats["stages"]:
             feedback.pushInfo(tr("{}: {:.1f} s, peak {:.0f} MB; {}").format(row[0], row[1], row[2], row[3]))
+        feedback.pushInfo(tr("Tiles ran on: {}").format(run.stats["executor"]))
         results = {key: run.paths[prod] for key, prod in self.OUTPUTS.items()}
         results[self.OUTPUT_FOLDER] = out_folder
         self._load(context, results)

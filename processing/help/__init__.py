@@ -132,6 +132,22 @@ HELP: dict[str, dict] = {
             "sample distance of the near-nadir images.",
             "REUSE_ORIENTATION": "Skip the orientation when OUTPUT_FOLDER already holds orientation.json "
             "(e.g. to rerun matching and the orthophoto with another resolution).",
+            "EXECUTOR": "Where the tiles of dense matching, DSM filtering and the true orthophoto are "
+            "computed, by one executor for the three stages (a local cluster starts once); the products "
+            "are identical with every choice. inprocess: in QGIS's process, one tile after the other on "
+            "all cores (the default). local: a Dask cluster of worker processes on this computer, "
+            "listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an "
+            "existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the photos and "
+            "OUTPUT_FOLDER at the same paths (shared storage) and have TruOrtho installed. A worker that "
+            "dies has its tiles recomputed by the others. The orientation, the mesh and the report are "
+            "computed in QGIS's process. The address is checked before the orientation starts; the scheduler "
+            "is first contacted by dense matching.",
+            "SCHEDULER_ADDRESS": "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
+            "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
+            "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
+            "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
+            "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
+            "that is not on this computer is refused.",
             "OUTPUT_FOLDER": "Folder of the products (created when missing; existing products are replaced).",
             "ORIENTATION": "orientation.json: the adjusted orientation.",
             "REPORT": "report.html (and report.json): the quality report of the run.",
@@ -244,6 +260,22 @@ HELP: dict[str, dict] = {
             "a cell; also bounds how far outside a tile occluders are searched.",
             "BLEND_WIDTH": "Width of the feathering across seamlines, in cells (0 = hard seams).",
             "TILE_SIZE": "Tile side in cells; memory grows with its square and the images per tile.",
+            "EXECUTOR": "Where the tiles of the mosaic are computed; the true orthophoto, source index, "
+            "occlusion mask and seamlines are identical with every choice. inprocess: in QGIS's process, "
+            "one tile after the other (the default). local: a Dask cluster of worker processes on this "
+            "computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: "
+            "an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images and the "
+            "surface at the same paths (shared storage) and have TruOrtho installed. A worker that dies "
+            "has its tiles recomputed by the others. The colour correction (on a decimated grid) is "
+            "estimated in QGIS's process. Finished tiles are kept in a folder beside the output (its name "
+            "plus '.tiles') until the run succeeds, so a rerun with the same inputs and parameters after a "
+            "crash reuses them.",
+            "SCHEDULER_ADDRESS": "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
+            "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
+            "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
+            "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
+            "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
+            "that is not on this computer is refused.",
             "OUTPUT": "GeoTIFF with the images' bands and data type plus an alpha band, tiled, with "
             "overviews, Cloud-Optimized GeoTIFF layout.",
             "SOURCE_INDEX": "Int16 GeoTIFF: index (0-based, orientation order) of the image each cell "

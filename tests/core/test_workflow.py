@@ -30,7 +30,7 @@ def test_workflow_products_and_report_from_a_reused_orientation(tmp_path):
     res = 2 * cfg.gsd
     fractions = []
     r = run_workflow(
-        [], out, config=WorkflowConfig(resolution=res, reuse_orientation=True),
+        [], out, config=WorkflowConfig(resolution=res, reuse_orientation=True, executor="inprocess"),
         progress=CallbackProgress(lambda f, m: fractions.append(f)),
     )  # fmt: skip
     for key, name in PRODUCTS.items():
@@ -45,6 +45,7 @@ def test_workflow_products_and_report_from_a_reused_orientation(tmp_path):
     assert ortho.shape[0] == 4 and og.crs and (ortho[3] > 0).mean() > 0.5
     rep = json.loads((out / "report.json").read_text())
     assert rep["summary"]["images oriented"] == len(o.images)
+    assert rep["summary"]["tiles ran on"] == r.stats["executor"] == "inprocess"
     stages = [t for t in rep["tables"] if t["title"] == "Stages"][0]["rows"]
     assert [s[0] for s in stages][:5] == [
         "orientation", "dense matching (OSGM)", "DSM filter", "mesh", "true orthophoto",
@@ -66,3 +67,41 @@ def test_workflow_bad_input(tmp_path):
         run_workflow([], tmp_path)
     with pytest.raises(InputError, match="RESOLUTION"):
         run_workflow(["x.jpg"], tmp_path, config=WorkflowConfig(resolution=-1.0))
+
+
+def test_workflow_executor_choice(tmp_path, monkeypatch):
+    """WorkflowConfig.executor: a bad name or scheduler address fails first with a clear InputError; a
+    valid one makes one executor, closed however the run ends (here: no images)."""
+    import truortho.core.parallel as parallel
+
+    with pytest.raises(InputError, match="EXECUTOR: expected one of inprocess, local, scheduler"):
+        run_workflow(["x.jpg"], tmp_path, config=WorkflowConfig(executor="gpu"))
+    monkeypatch.delenv(parallel.SCHEDULER_ENV, raising=False)
+    with pytest.raises(InputError, match="SCHEDULER_ADDRESS"):
+        run_workflow(["x.jpg"], tmp_path, config=WorkflowConfig(executor="scheduler"))
+    with pytest.raises(InputError, match="unauthenticated"):
+        run_workflow(
+            ["x.jpg"], tmp_path,
+            config=WorkflowConfig(executor="scheduler", scheduler_address="tcp://198.51.100.7:8786"),
+        )  # fmt: skip
+    assert not any(tmp_path.iterdir())  # nothing written
+    made, closed = [], []
+    real = parallel.make_executor
+
+    def spy(*args, **kw):
+        ex = real(*args, **kw)
+        close = ex.close
+
+        def recorded_close():
+            closed.append(ex.name)
+            close()
+
+        ex.close = recorded_close
+        made.append(ex.name)
+        return ex
+
+    monkeypatch.setattr(parallel, "make_executor", spy)
+    for kind in ("inprocess", "local"):
+        with pytest.raises(InputError, match="IMAGES"):
+            run_workflow([], tmp_path / kind, config=WorkflowConfig(executor=kind))
+    assert made == closed == ["inprocess", "local"]

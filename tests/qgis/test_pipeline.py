@@ -46,7 +46,7 @@ def test_pipeline_reusing_the_orientation(truortho_provider, block, tmp_path):
     context.setProject(QgsProject.instance())
     res = processing.run(
         "truortho:pipeline",
-        {"REUSE_ORIENTATION": True, "RESOLUTION": 0.6, "OUTPUT_FOLDER": str(out)},
+        {"REUSE_ORIENTATION": True, "RESOLUTION": 0.6, "EXECUTOR": 0, "OUTPUT_FOLDER": str(out)},
         context=context,
     )
     for key, name in (
@@ -59,10 +59,26 @@ def test_pipeline_reusing_the_orientation(truortho_provider, block, tmp_path):
     assert dsm.isValid() and dsm.crs().authid() == "EPSG:32632"
     rep = json.loads((out / "report.json").read_text())
     assert rep["summary"]["images oriented"] == len(scene.orientation.images)
+    assert rep["summary"]["tiles ran on"] == "inprocess"
     # the GUI run registers the products to load on completion
     assert context.willLoadLayerOnCompletion(res["TRUE_ORTHO"]) and context.willLoadLayerOnCompletion(
         res["DSM"]
     )
+
+
+def test_pipeline_executor_parameters(truortho_provider):
+    """One EXECUTOR (inprocess | local | scheduler, default inprocess) and SCHEDULER_ADDRESS, advanced."""
+    from qgis.core import QgsApplication, QgsProcessingParameterDefinition
+
+    alg = QgsApplication.processingRegistry().algorithmById("truortho:pipeline")
+    executor = alg.parameterDefinition("EXECUTOR")
+    address = alg.parameterDefinition("SCHEDULER_ADDRESS")
+    assert executor is not None and address is not None
+    assert [o.split(":")[0] for o in executor.options()] == ["inprocess", "local", "scheduler"]
+    assert executor.defaultValue() == 0
+    assert address.flags() & QgsProcessingParameterDefinition.FlagOptional
+    for p in (executor, address):
+        assert p.flags() & QgsProcessingParameterDefinition.FlagAdvanced, p.name()
 
 
 def test_pipeline_bad_input(truortho_provider, block, tmp_path):
@@ -81,6 +97,18 @@ def test_pipeline_bad_input(truortho_provider, block, tmp_path):
             "truortho:pipeline",
             {"IMAGES": str(images), "RESOLUTION": -1, "OUTPUT_FOLDER": str(tmp_path / "b")},
         )
+    # a plain tcp:// scheduler off this machine: refused before the orientation starts
+    with pytest.raises(QgsProcessingException, match="unauthenticated"):
+        processing.run(
+            "truortho:pipeline",
+            {
+                "IMAGES": str(images),
+                "EXECUTOR": 2,
+                "SCHEDULER_ADDRESS": "tcp://198.51.100.7:8786",
+                "OUTPUT_FOLDER": str(tmp_path / "s"),
+            },
+        )
+    assert not (tmp_path / "s" / "orientation.json").exists()
     # GCPS without OBSERVATIONS
     from qgis.core import QgsVectorLayer
 

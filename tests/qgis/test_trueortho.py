@@ -26,6 +26,21 @@ def run(params):
     return processing.run("truortho:trueortho", params)
 
 
+def test_trueortho_executor_parameters(truortho_provider):
+    """EXECUTOR (inprocess | local | scheduler, default inprocess) and SCHEDULER_ADDRESS: advanced."""
+    from qgis.core import QgsApplication, QgsProcessingParameterDefinition
+
+    alg = QgsApplication.processingRegistry().algorithmById("truortho:trueortho")
+    executor = alg.parameterDefinition("EXECUTOR")
+    address = alg.parameterDefinition("SCHEDULER_ADDRESS")
+    assert executor is not None and address is not None
+    assert len(executor.options()) == 3 and executor.defaultValue() == 0
+    assert [o.split(":")[0] for o in executor.options()] == ["inprocess", "local", "scheduler"]
+    assert address.flags() & QgsProcessingParameterDefinition.FlagOptional
+    for p in (executor, address):
+        assert p.flags() & QgsProcessingParameterDefinition.FlagAdvanced, p.name()
+
+
 def test_trueortho_outputs(truortho_provider, scene_dir, tmp_path):
     from qgis.core import QgsRasterLayer, QgsVectorLayer
 
@@ -37,6 +52,7 @@ def test_trueortho_outputs(truortho_provider, scene_dir, tmp_path):
             "ORIENTATION": str(root / "orientation.json"),
             "SURFACE": str(root / "dsm.tif"),
             "BLEND_WIDTH": 3,
+            "EXECUTOR": 0,  # inprocess (the default), explicitly
             "OUTPUT": str(tmp_path / "ortho.tif"),
             "SOURCE_INDEX": str(tmp_path / "idx.tif"),
             "OCCLUSION": str(tmp_path / "occ.tif"),
@@ -54,6 +70,7 @@ def test_trueortho_outputs(truortho_provider, scene_dir, tmp_path):
     assert names <= {im.name for im in scene.orientation.images}
     a, _, _ = read_raster(res["OUTPUT"], band=4)
     assert (a > 0).mean() > 0.95
+    assert not list(tmp_path.glob("*.tiles"))  # the scratch tiles are gone after success
 
 
 def test_trueortho_extent_and_crs(truortho_provider, scene_dir, tmp_path):
@@ -101,6 +118,18 @@ def test_trueortho_bad_input(truortho_provider, scene_dir, tmp_path):
                 "ORIENTATION": str(tmp_path / "moved.json"),
                 "SURFACE": str(root / "dsm.tif"),
                 "OUTPUT": str(tmp_path / "bad2.tif"),
+            }
+        )
+    # a plain tcp:// scheduler off this machine is refused (before any output is written)
+    with pytest.raises(QgsProcessingException, match="unauthenticated"):
+        run(
+            {
+                "ORIENTATION": str(root / "orientation.json"),
+                "SURFACE": str(root / "dsm.tif"),
+                "COLOR_CORRECTION": False,
+                "EXECUTOR": 2,
+                "SCHEDULER_ADDRESS": "tcp://198.51.100.7:8786",
+                "OUTPUT": str(tmp_path / "bad3.tif"),
             }
         )
     assert not list(tmp_path.glob("bad*"))
