@@ -1,9 +1,10 @@
-"""Benchmark of tile-parallel OSGM: in-process, and a local Dask cluster of 1 and 2 worker processes.
+"""Benchmark of tile-parallel OSGM and true ortho: in-process, and a local Dask cluster of 1 and 2 workers.
 
 Not a test. Run from the repository root with the project's interpreter::
 
     source scripts/env.sh
     python -P bench/bench_parallel.py [--scale 2] [--resolution 0.25] [--tile 128] [--skip-inprocess]
+                                      [--stage osgm|ortho|all] [--ortho-tile 512]
 
 The scene is the default synthetic scene (``core/synthetic``: 120 x 100 m, 7 buildings and a
 tower) with its extent scaled by ``--scale`` in both directions (default 2: 4x the area, 4x the
@@ -23,6 +24,11 @@ memory of every worker process (``VmHWM``) and of this process (``ru_maxrss``), 
 ``t(1 worker) / (2 t(2 workers))``, and per-tile costs of the finest level from the Dask task
 stream of the 1-worker run (seconds per tile and per million cells, all levels included). The
 machine is shared (2 cores): wall times are indicative. Results go to ``bench/results/parallel.json``.
+
+``--stage ortho`` (and ``all``) does the same for ``true_ortho`` onto the scene's truth DSM at the GSD
+(colour correction on; the mosaic, source index and occlusion mask must be bit-identical in all
+runs); its tiles run in waves (``core/ortho/tiles.py``), so the efficiency also shows what the waves
+cost. The colour statistics (on a decimated grid) run in the client in every configuration.
 """
 
 from __future__ import annotations
@@ -67,12 +73,88 @@ def _run(scene, folder, out, res, tile, executor):
     return time.perf_counter() - t, r
 
 
+def _ortho(scene, folder, out, tile, executor):
+    from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho
+
+    t = time.perf_counter()
+    r = true_ortho(
+        folder / "orientation.json", folder / "dsm.tif", out, str(out)[:-4] + "_idx.tif",
+        str(out)[:-4] + "_occ.tif", TrueOrthoConfig(tile_size=tile, extent=scene.extent_world()),
+        executor=executor,
+    )  # fmt: skip
+    return time.perf_counter() - t, r
+
+
+def _bench_ortho(scene, folder, tmp, tile, skip_inprocess) -> dict:
+    """In-process, 1 and 2 Dask workers for the true orthophoto (module docstring)."""
+    from truortho.core.parallel import LocalDaskExecutor
+    from truortho.core.rasterio_io import read_raster
+
+    def products(p):
+        return [read_raster(x, band=None)[0] for x in (p, str(p)[:-4] + "_idx.tif", str(p)[:-4] + "_occ.tif")]
+
+    res: dict = {"tile": tile, "runs": {}}
+    prods = {}
+    if not skip_inprocess:
+        wall, r = _ortho(scene, folder, tmp / "o_inprocess.tif", tile, None)
+        prods["inprocess"] = products(tmp / "o_inprocess.tif")
+        st = r.stats
+        res["grid"] = [st["cols"], st["rows"], st["tiles"]]
+        res["task_memory_mb"] = st["task_memory_mb"]
+        res["runs"]["inprocess"] = {"wall": wall, "seconds_color": st["seconds_color"]}
+        print(f"true ortho inprocess: {wall:.1f} s, {st['cols']} x {st['rows']} cells, {st['tiles']} tiles; "
+              f"colour statistics {st['seconds_color']:.1f} s; estimated memory per task "
+              f"{st['task_memory_mb']:.0f} MB")  # fmt: skip
+    for n in (1, 2):
+        ex = LocalDaskExecutor(n_workers=n, memory_limit="4GiB", numba_threads=1)
+        t = time.perf_counter()
+        client = ex._client()
+        client.run(lambda: __import__("truortho.core.ortho.tiles"))
+        start = time.perf_counter() - t
+        from distributed import get_task_stream
+
+        with get_task_stream(client) as stream:
+            wall, r = _ortho(scene, folder, tmp / f"o_dask{n}.tif", tile, ex)
+        secs = np.array([
+            sum(x["stop"] - x["start"] for x in d["startstops"] if x["action"] == "compute")
+            for d in stream.data if str(d["key"]).startswith("truortho-tile-")
+        ])  # fmt: skip
+        peaks = sorted(client.run(_peak_rss_mb).values())
+        ex.close()
+        prods[f"dask-{n}"] = products(tmp / f"o_dask{n}.tif")
+        res["runs"][f"dask-{n}"] = {"wall": wall, "startup": start, "peak_mb_per_worker": peaks,
+                                    "task_compute_s": float(secs.sum()), "tiles": len(secs),
+                                    "seconds_color": r.stats["seconds_color"]}  # fmt: skip
+        print(f"true ortho dask-{n}: {wall:.1f} s (+ {start:.1f} s cluster start), peak RSS per worker "
+              + ", ".join(f"{p:.0f} MB" for p in peaks)
+              + f"; tile compute summed {secs.sum():.1f} s over {len(secs)} tiles (mean {secs.mean():.2f} s, "
+              f"max {secs.max():.2f} s)")  # fmt: skip
+        if n == 1:
+            cells = r.stats["rows"] * r.stats["cols"]
+            res["s_per_mcell"] = float(secs.sum() / cells * 1e6)
+            res["serial_s"] = wall - float(secs.sum())
+            print(f"  {secs.sum() / cells * 1e6:.2f} s of one core per million ortho cells (tiles only); "
+                  f"client time outside the tiles {wall - secs.sum():.1f} s "
+                  f"({(wall - secs.sum()) / cells * 1e6:.2f} s per million cells: colour statistics, "
+                  f"writing, seamlines)")  # fmt: skip
+    ref = next(iter(prods.values()))
+    same = all(all(np.array_equal(a, b) for a, b in zip(ref, p, strict=True)) for p in prods.values())
+    t1, t2 = res["runs"]["dask-1"]["wall"], res["runs"]["dask-2"]["wall"]
+    res["efficiency_2"] = t1 / (2 * t2)
+    res["identical"] = same
+    print(f"true ortho parallel efficiency with 2 workers: t1 / (2 t2) = {t1:.1f} / (2 x {t2:.1f}) = "
+          f"{t1 / (2 * t2):.2f}; mosaic, index and occlusion bit-identical: {same}")  # fmt: skip
+    return res
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--scale", type=float, default=2.0, help="extent factor per axis (2 = 4x the area)")
     ap.add_argument("--resolution", type=float, default=None, help="DSM cell (default twice the GSD)")
     ap.add_argument("--tile", type=int, default=128)
     ap.add_argument("--skip-inprocess", action="store_true")
+    ap.add_argument("--stage", choices=("osgm", "ortho", "all"), default="all")
+    ap.add_argument("--ortho-tile", type=int, default=512)
     args = ap.parse_args(argv)
 
     from truortho.core.parallel import LocalDaskExecutor
@@ -101,6 +183,13 @@ def main(argv=None) -> int:
     )
     results: dict = {"scene": {"scale": s, "images": n_img, "image_size": [w, h], "gsd": cfg.gsd},
                      "resolution": res, "tile": args.tile, "runs": {}}  # fmt: skip
+    ok = True
+    if args.stage in ("ortho", "all"):
+        results["ortho"] = _bench_ortho(scene, folder, tmp, args.ortho_tile, args.skip_inprocess)
+        ok = ok and results["ortho"]["identical"]
+    if args.stage == "ortho":
+        _save(results)
+        return 0 if ok else 1
     products = {}
     if not args.skip_inprocess:
         wall, r = _run(scene, folder, tmp / "inprocess.tif", res, args.tile, None)
@@ -161,10 +250,14 @@ def main(argv=None) -> int:
     print(f"the same tiles took {c2 / c1:.2f}x the compute time with 2 workers (core contention)")
     print(f"parallel efficiency with 2 workers: t1 / (2 t2) = {t1:.1f} / (2 x {t2:.1f}) = {eff:.2f}; "
           f"DSMs bit-identical: {same}")  # fmt: skip
+    _save(results)
+    return 0 if (same and ok) else 1
+
+
+def _save(results: dict) -> None:
     out = Path(__file__).resolve().parent / "results"
     out.mkdir(exist_ok=True)
     (out / "parallel.json").write_text(json.dumps(results, indent=1))
-    return 0 if same else 1
 
 
 if __name__ == "__main__":

@@ -50,10 +50,10 @@ from .mosaic import ImageStore, MosaicParams, candidate_colours
 from .seams import dissolve, region_polygons
 from .surface import PlanTransform, open_surface, same_crs, transform_bounds
 from .tiles import (
+    DoneLabels,
     OrthoContext,
     OrthoTask,
     candidates_bound,
-    fixed_labels,
     ortho_tile_task,
     side_of,
     task_memory,
@@ -119,7 +119,7 @@ class TrueOrthoConfig:
         Cloud-Optimized GeoTIFF layout (with overviews) for the rasters.
     executor : {"inprocess", "local", "scheduler"}
         Where the mosaic tiles run (:mod:`truortho.core.parallel`; the colour statistics, on a
-        decimated grid, always run here). Tiles run in waves (:mod:`.tiles`); the mosaic is
+        decimated grid, always run here). Tiles run in four waves (:mod:`.tiles`); the mosaic is
         bit-identical on every backend.
     scheduler_address : str, optional
         Dask scheduler of ``executor="scheduler"`` (default ``$TRUORTHO_DASK_SCHEDULER``).
@@ -434,6 +434,13 @@ def true_ortho(
 
         if own_executor:
             stack.callback(executor.close)
+        if cache is not None:
+            # a cancelled run leaves no scratch tiles (a crash keeps them for the rerun)
+            stack.push(
+                lambda et, ev, tb: cache.finish()
+                if et is not None and issubclass(et, CancelledError)
+                else None
+            )
 
         w_out = stack.enter_context(
             RasterWriter(
@@ -480,7 +487,7 @@ def true_ortho(
                 )
             )
         tri_max = 0
-        done: dict[tuple[int, int], tuple] = {}  # core window and labels of finished tiles
+        done = DoneLabels(overlap)  # border strips of the labels of finished tiles
         ctx = OrthoContext(
             setup,
             surf,
@@ -496,22 +503,28 @@ def true_ortho(
             workers,
             store=store,
         )
+        k_max = candidates_bound(setup, grid, tiles, to_local)
+        img_bytes = max(w * h for w, h in (sizes[i] for i in relevant)) * bands * dtype.itemsize * 4 // 3
         memory = task_memory(
             side_of(cfg.tile_size, overlap),
             setup.margin_cells,
-            candidates_bound(setup, grid, side_of(cfg.tile_size, overlap)),
+            k_max,
             bands,
-            cfg.image_cache_mb << 20,
+            min(cfg.image_cache_mb << 20, k_max * img_bytes),
         )
+        stats["max_candidates_per_tile"] = k_max
         stats["task_memory_mb"] = round(memory / 2**20, 1)
         base = ""
         if cache is not None:
             base = _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs)
         n_done = 0
-        tile_cols = 1 + max(t.index[1] for t in tiles)
-        for w, wave in enumerate(waves(tiles)):
+        # a wave runs in batches of at most ~256 MiB of results, so the client's memory is bounded
+        per_tile = (cfg.tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
+        batch_tiles = max(1, (256 << 20) // per_tile)
+        batches = [w[i : i + batch_tiles] for w in waves(tiles) for i in range(0, len(w), batch_tiles)]
+        for wave in batches:
             check(progress)
-            tasks = [OrthoTask(t, fixed_labels(t, done)) for t in wave]
+            tasks = [OrthoTask(t, done.fixed(t)) for t in wave]
             wsub = SubProgress(sub, n_done / len(tiles), (n_done + len(wave)) / len(tiles))
             try:
                 results = executor.map_tiles(
@@ -530,7 +543,7 @@ def true_ortho(
                 n_samples += int(counters[0])
                 tri_max = max(tri_max, int(counters[1]))
                 w_out.write(out_t, tile.core)
-                done[tile.index] = (tile.core, lab)
+                done.add(tile, lab)
                 if w_idx is not None:
                     w_idx.write(lab, tile.core)
                 if w_occ is not None:
@@ -543,10 +556,6 @@ def true_ortho(
                 for k, polys in region_polygons(lab, tile.core_grid(grid).transform).items():
                     parts.setdefault(k, []).extend(polys)
             n_done += len(wave)
-            # later waves need only the rows from their first row - 1 on
-            first_next = max(0, -(-(w + 1 - (tile_cols - 1)) // 2))
-            for key in [k for k in done if k[0] < first_next - 1]:
-                del done[key]
             sub.update(n_done / len(tiles), f"tile {n_done}/{len(tiles)}")
         check(progress)
         steps[3].update(0.0, "writing overviews")

@@ -9,12 +9,18 @@ tile and the labels its neighbours already chose inside its outer window).
 It returns the tile's *core*: values + alpha in the images' data type, the
 source index (int16) and the occlusion mask (uint8), plus two counters.
 
-Order of tiles (:func:`waves`): a tile continues the labels of the tiles
-whose cores meet its outer window (row above: left, same, right; same row:
-left), so that seams do not start at tile borders. Tile ``(i, j)`` therefore
-runs after those four; all tiles with the same ``2 i + j`` (a *wave*) are
-independent of each other and run in parallel. Every backend runs the same
-waves with the same inputs, so the mosaic is bit-identical everywhere.
+Order of tiles (:func:`waves`): a tile continues the labels that finished
+neighbouring tiles wrote inside its outer window, so that seams do not start
+at tile borders. The tiles run in four *waves* by the parity of their index
+``(i, j)``: first every ``(even, even)`` tile (their outer windows meet no
+other core of the wave), then ``(even, odd)`` (continuing their left and
+right neighbours), then ``(odd, even)`` (above and below), then
+``(odd, odd)`` (all eight neighbours). Tiles of one wave are independent, so
+a wave is one parallel call of a quarter of the tiles, whatever the size of
+the grid. Every backend runs the same waves with the same inputs, so the
+mosaic is bit-identical everywhere. Between waves the client keeps only the
+border strips (overlap wide) of the finished tiles' labels
+(:class:`DoneLabels`).
 
 On a worker, the images are decoded through an :class:`~.mosaic.ImageStore`
 kept per worker process (:func:`worker_store`, an LRU of two keyed by the
@@ -25,9 +31,10 @@ outer window of ``n`` cells, the per-candidate arrays (pixel coordinates
 8 B, effective resolution 4 B, flags 2 B, data cost 4 B, luminance 4 B,
 blend weight 4 B, colours ``4 x bands`` B), i.e. ``K n (26 + 4 bands)``
 bytes, plus the occluder region (``(side + 2 margin)^2 x 26`` B: heights,
-masks, triangles) and the decoded images the worker caches
-(``image_cache_mb``). With the default 512-cell tile (+ 2 x 13 overlap),
-16 candidates and RGB: 16 x 538^2 x 38 B = 176 MB.
+masks, triangles) and the decoded images of the candidates (at most
+``image_cache_mb``, the worker's image cache; 4/3 of the image for its
+reduced levels). With the default 512-cell tile (+ 2 x 13 overlap), 16
+candidates and RGB: 16 x 538^2 x 38 B = 176 MB.
 """
 
 from __future__ import annotations
@@ -146,49 +153,62 @@ def ortho_tile_task(ctx: OrthoContext, task: OrthoTask):
 
 
 def waves(tiles: list[Tile]) -> list[list[Tile]]:
-    """Tiles grouped by ``2 i + j`` (module docstring), each group in row-major order."""
-    groups: dict[int, list[Tile]] = {}
-    for t in tiles:
-        groups.setdefault(2 * t.index[0] + t.index[1], []).append(t)
-    return [groups[k] for k in sorted(groups)]
+    """The tiles in four parity waves (module docstring), each in row-major order."""
+    order = ((0, 0), (0, 1), (1, 0), (1, 1))
+    out = [[t for t in tiles if (t.index[0] % 2, t.index[1] % 2) == p] for p in order]
+    return [w for w in out if w]
 
 
-def fixed_labels(tile: Tile, done: dict) -> np.ndarray:
-    """Labels already decided in the tile's outer window by finished tiles (-1 elsewhere), int16."""
-    r0, c0, nr, nc = tile.outer
-    out = np.full((nr, nc), -1, np.int16)
-    for (cr0, cc0, cnr, cnc), lab in done.values():
-        a0, a1 = max(r0, cr0), min(r0 + nr, cr0 + cnr)
-        b0, b1 = max(c0, cc0), min(c0 + nc, cc0 + cnc)
-        if a1 > a0 and b1 > b0:
-            out[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0] = lab[a0 - cr0 : a1 - cr0, b0 - cc0 : b1 - cc0]
-    return out
+class DoneLabels:
+    """Border strips (``width`` cells) of the labels of finished tile cores, by tile index."""
+
+    def __init__(self, width: int) -> None:
+        self.width = max(int(width), 1)
+        self._strips: dict[tuple[int, int], list[tuple[int, int, np.ndarray]]] = {}
+
+    def add(self, tile: Tile, labels: np.ndarray) -> None:
+        r0, c0, nr, nc = tile.core
+        w = self.width
+        lab = np.asarray(labels)
+        strips = [(r0, c0, lab[:w].copy()), (r0 + max(nr - w, 0), c0, lab[max(nr - w, 0) :].copy())]
+        strips += [(r0, c0, lab[:, :w].copy()), (r0, c0 + max(nc - w, 0), lab[:, max(nc - w, 0) :].copy())]
+        self._strips[tile.index] = strips
+
+    def fixed(self, tile: Tile) -> np.ndarray:
+        """Labels already decided in the tile's outer window (-1 elsewhere), int16."""
+        r0, c0, nr, nc = tile.outer
+        out = np.full((nr, nc), -1, np.int16)
+        for strips in self._strips.values():
+            for sr0, sc0, lab in strips:
+                snr, snc = lab.shape
+                a0, a1 = max(r0, sr0), min(r0 + nr, sr0 + snr)
+                b0, b1 = max(c0, sc0), min(c0 + nc, sc0 + snc)
+                if a1 > a0 and b1 > b0:
+                    out[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0] = lab[a0 - sr0 : a1 - sr0, b0 - sc0 : b1 - sc0]
+        return out
 
 
-def task_memory(outer_side: int, margin: int, candidates: int, bands: int, cache_bytes: int) -> int:
-    """Bytes one task needs at most (module docstring)."""
+def task_memory(outer_side: int, margin: int, candidates: int, bands: int, image_bytes: int) -> int:
+    """Bytes one task needs at most (module docstring); ``image_bytes``: the decoded images it may
+    hold (at most the image cache)."""
     n = int(outer_side) ** 2
     per_candidate = int(candidates) * n * (26 + 4 * int(bands))
     region = (int(outer_side) + 2 * int(margin)) ** 2 * 26
-    return per_candidate + region + int(cache_bytes)
+    return per_candidate + region + int(image_bytes)
 
 
-def candidates_bound(setup: ViewSetup, grid: RasterGrid, side: int) -> int:
-    """Most images whose footprint boxes meet one square window of ``side`` cells (a bound of K)."""
+def candidates_bound(setup: ViewSetup, grid: RasterGrid, tiles: list[Tile], to_local: PlanTransform) -> int:
+    """Most candidate images of one tile: footprint boxes meeting the tile's outer window."""
     b = setup.boxes
-    ok = np.all(np.isfinite(b), axis=1)
-    if not ok.any():
-        return 1
-    w = side * grid.res
-    sizes = np.maximum(b[ok, 2] - b[ok, 0], b[ok, 3] - b[ok, 1])
-    # an image meets a window of side w when the centres are within (size + w) / 2; bound by
-    # the images whose box can reach any single point (the densest overlap), plus the window
-    cx, cy = 0.5 * (b[ok, 0] + b[ok, 2]), 0.5 * (b[ok, 1] + b[ok, 3])
-    best = 0
-    for x, y in zip(cx, cy, strict=True):
-        reach = 0.5 * (sizes + w)
-        best = max(best, int(np.sum((np.abs(cx - x) <= reach) & (np.abs(cy - y) <= reach))))
-    return max(1, min(best, len(sizes)))
+    best = 1
+    for t in tiles:
+        x0, y0, x1, y1 = t.outer_grid(grid).extent
+        lx, ly = to_local.xy(np.array([x0, x1, x0, x1]), np.array([y0, y0, y1, y1]))
+        with np.errstate(invalid="ignore"):
+            hit = (b[:, 0] <= lx.max()) & (b[:, 2] >= lx.min())
+            hit &= (b[:, 1] <= ly.max()) & (b[:, 3] >= ly.min())
+        best = max(best, int(np.count_nonzero(hit)))
+    return best
 
 
 def side_of(tile_size: int, overlap: int) -> int:
@@ -199,7 +219,7 @@ __all__ = [
     "OrthoContext",
     "OrthoTask",
     "candidates_bound",
-    "fixed_labels",
+    "DoneLabels",
     "ortho_tile_task",
     "side_of",
     "task_memory",
