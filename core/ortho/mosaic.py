@@ -43,8 +43,29 @@ class ImageStore:
         self._cache: OrderedDict = OrderedDict()
         self._bytes = 0
         self.reads = 0
+        import threading
+
+        self._lock = threading.RLock()
 
     def get(self, i: int, level: int = 0) -> np.ndarray:
+        """The decoded image ``i`` at ``level`` (thread-safe: tiles may run in threads)."""
+        with self._lock:
+            return self._get(i, level)
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state["_lock"] = None
+        state["_cache"] = OrderedDict()
+        state["_bytes"] = 0
+        return state
+
+    def __setstate__(self, state) -> None:
+        import threading
+
+        self.__dict__.update(state)
+        self._lock = threading.RLock()
+
+    def _get(self, i: int, level: int = 0) -> np.ndarray:
         key = (int(i), int(level))
         if key in self._cache:
             self._cache.move_to_end(key)
@@ -61,7 +82,7 @@ class ImageStore:
         else:
             import cv2
 
-            src = self.get(i, level - 1)
+            src = self._get(i, level - 1)
             h, w = src.shape[:2]
             nw, nh = max(1, (w + 1) // 2), max(1, (h + 1) // 2)
             if src.ndim == 3 and src.shape[2] > 4:
@@ -132,13 +153,25 @@ def sample_points(img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[
 
 
 def luminance01(col: np.ndarray, dtype) -> np.ndarray:
-    """Luminance in [0, 1]-ish units of samples (..., bands) float32 (Rec. 601 for RGB, band 1 otherwise)."""
-    s = value_scale(dtype)
-    if col.shape[-1] >= 3:
-        lum = 0.299 * col[..., 0] + 0.587 * col[..., 1] + 0.114 * col[..., 2]
-    else:
-        lum = col[..., 0]
-    return (lum / s).astype(np.float32)
+    """Luminance in [0, 1]-ish units of samples (..., bands) float32 (Rec. 601 for RGB, band 1 otherwise).
+
+    NaN where the sample is NaN.
+    """
+    s = float(value_scale(dtype))
+    c = np.ascontiguousarray(col, dtype=np.float32)
+    out = np.empty(c.shape[:-1], np.float32)
+    _luminance(c.reshape(-1, c.shape[-1]), 1.0 / s, out.reshape(-1))
+    return out
+
+
+@njit
+def _luminance(c, inv_scale, out):
+    rgb = c.shape[1] >= 3
+    for i in range(c.shape[0]):
+        if rgb:
+            out[i] = (0.299 * c[i, 0] + 0.587 * c[i, 1] + 0.114 * c[i, 2]) * inv_scale
+        else:
+            out[i] = c[i, 0] * inv_scale
 
 
 @dataclass

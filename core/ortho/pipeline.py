@@ -43,7 +43,7 @@ from ..errors import CancelledError, CRSError, InputError, MissingFileError
 from ..grid import RasterGrid
 from ..imagery import image_info
 from ..orientation import Orientation, as_orientation
-from ..parallel import Digest, TileCache, file_identity
+from ..parallel import Digest, InProcessExecutor, TileCache, file_identity
 from ..progress import Progress, Steps, SubProgress, as_progress, check
 from .color import ColorCorrection, estimate_corrections, to_channels
 from .mosaic import ImageStore, MosaicParams, candidate_colours
@@ -103,6 +103,11 @@ class TrueOrthoConfig:
         tan(MAX_VIEW_ANGLE); steps below twice that cannot hide a cell seen within that angle).
     zbuffer_oversample : float
         Depth-buffer pixels per output cell when the image pixel is finer than the cell.
+    top_views : int
+        After the visibility of a tile, only the images among the ``top_views`` best (smallest
+        effective resolution) of at least one cell stay candidates of the tile (0 = all): with
+        tens of images over a tile the others cannot win a cell but cost memory and time in
+        the selection and blending. The colour statistics always use every image.
     views_per_cell : int
         Candidates of a tile are evaluated in order of their resolution over the tile; a cell
         takes no further candidate once this many images see it cleanly (visible, not next to
@@ -114,7 +119,8 @@ class TrueOrthoConfig:
     color_cells : int
         Cells of the decimated grid used to estimate the colour correction.
     workers : int
-        Threads for the per-image depth buffers of a tile.
+        Threads in this process: the independent tiles of a wave run in this many threads, and
+        the per-image depth buffers of a tile too.
     cog : bool
         Cloud-Optimized GeoTIFF layout (with overviews) for the rasters.
     executor : {"inprocess", "local", "scheduler"}
@@ -148,6 +154,7 @@ class TrueOrthoConfig:
     wall_min: float | None = None
     zbuffer_oversample: float = 1.0
     views_per_cell: int = 0
+    top_views: int = 8
     image_cache_mb: int = 1024
     color_cells: int = 60_000
     workers: int = 2
@@ -171,6 +178,8 @@ class TrueOrthoConfig:
             bad("max_view_angle", "expected degrees in (0, 89)")
         if not isinstance(self.blend_width, int) or not 0 <= self.blend_width <= 1000:
             bad("blend_width", "expected an integer number of cells in [0, 1000]")
+        if not isinstance(self.top_views, int) or not 0 <= self.top_views <= 1000:
+            bad("top_views", "expected an integer >= 0 (0 = every image)")
         if not isinstance(self.views_per_cell, int) or not 0 <= self.views_per_cell <= 1000:
             bad("views_per_cell", "expected an integer >= 0 (0 = every image)")
         if not isinstance(self.tile_size, int) or not 32 <= self.tile_size <= 8192:
@@ -342,6 +351,7 @@ def true_ortho(
         cfg.discontinuity,
         cfg.edge_shift,
         views_per_cell=cfg.views_per_cell,
+        top_views=cfg.top_views,
     )
     if cfg.visibility and setup.margin_cells > 0:
         setup.blocks = HeightBlocks.of(surf, grid)
@@ -417,6 +427,10 @@ def true_ortho(
         from ..parallel import make_executor
 
         executor = make_executor(cfg.executor, cfg.scheduler_address, n_workers=cfg.dask_workers)
+    tile_executor = executor
+    if isinstance(executor, InProcessExecutor) and executor.threads < workers:
+        # in this process the tiles of a wave run in ``workers`` threads (they are independent)
+        tile_executor = InProcessExecutor(threads=workers)
     cache = None
     if cfg.cache_dir is not None:
         cache = TileCache(cfg.cache_dir)
@@ -527,7 +541,7 @@ def true_ortho(
             tasks = [OrthoTask(t, done.fixed(t)) for t in wave]
             wsub = SubProgress(sub, n_done / len(tiles), (n_done + len(wave)) / len(tiles))
             try:
-                results = executor.map_tiles(
+                results = tile_executor.map_tiles(
                     ortho_tile_task,
                     tasks,
                     wsub,
@@ -646,7 +660,9 @@ def _estimate_colour(
     # the depth margin is in cells of the grid used
     import dataclasses
 
-    st = dataclasses.replace(setup, margin_cells=int(math.ceil(setup.margin_cells / f)) + 1, views_per_cell=0)
+    st = dataclasses.replace(
+        setup, margin_cells=int(math.ceil(setup.margin_cells / f)) + 1, views_per_cell=0, top_views=0
+    )
     tiles = g.tiles(cfg.tile_size, 0)
     cells, imgs, vals = [], [], []
     for n, tile in enumerate(tiles):

@@ -181,6 +181,15 @@ class DsmSurface:
             raise InputError(f"{name}: {self.path} band {band} is not numeric")
         self.band = band
         self._range: tuple[float, float] | None = None
+        self._array: np.ndarray | None = None
+
+    #: A DSM of at most this many cells is kept in memory once read (8 B per cell).
+    memory_cells = 16_000_000
+
+    def __getstate__(self):
+        state = dict(self.__dict__)
+        state["_array"] = None  # a worker reads its own copy
+        return state
 
     def height_range(self) -> tuple[float, float]:
         """(min, max) of the valid heights, read in strips (bounded memory)."""
@@ -215,6 +224,20 @@ class DsmSurface:
         dst = np.full(grid.shape, np.nan, np.float64)
         with rasterio.open(self.path) as ds:
             win = _aligned_window(ds, grid, self.crs)
+            if win is not None and ds.width * ds.height <= self.memory_cells:
+                # a DSM this small is read once and kept (tiles read overlapping regions of it)
+                if self._array is None:
+                    a = ds.read(self.band).astype(np.float64)
+                    if ds.nodata is not None:
+                        a[a == ds.nodata] = np.nan
+                    a[~np.isfinite(a)] = np.nan
+                    self._array = a
+                r0, c0 = win
+                rs0, cs0 = max(r0, 0), max(c0, 0)
+                rs1, cs1 = min(r0 + grid.rows, ds.height), min(c0 + grid.cols, ds.width)
+                if rs1 > rs0 and cs1 > cs0:
+                    dst[rs0 - r0 : rs1 - r0, cs0 - c0 : cs1 - c0] = self._array[rs0:rs1, cs0:cs1]
+                return dst
             if win is not None:  # same CRS and cells: a windowed read, no resampling
                 r0, c0 = win
                 rs0, cs0 = max(r0, 0), max(c0, 0)

@@ -62,6 +62,7 @@ class ViewSetup:
     edge_shift: float = 0.75  # cells
     views_per_cell: int = 0  # clean views after which a cell takes no further candidate (0 = all)
     blocks: HeightBlocks | None = None  # block maxima/minima of the surface: a margin per tile
+    top_views: int = 0  # keep the candidates among the best this many of some cell (0 = all)
 
 
 @dataclass
@@ -183,6 +184,7 @@ def prepare_views(
     edge_shift: float = 0.75,
     max_margin_cells: int = 1024,
     views_per_cell: int = 0,
+    top_views: int = 0,
 ) -> ViewSetup:
     images = list(orientation.images)
     cams = [orientation.camera_of(im) for im in images]
@@ -209,6 +211,8 @@ def prepare_views(
         max(float(discontinuity), 2.0 * res),
         float(edge_shift),
         int(views_per_cell),
+        None,
+        int(top_views),
     )
 
 
@@ -405,11 +409,12 @@ def tile_views(
     def one(k, cells):
         im = setup.images[k]
         cam = setup.cameras[k]
-        sub, uvp, dist = frame_cells(P[cells], im.R, im.C, cam, setup.max_view)
+        sub, uvp, dist = frame_cells(P, im.R, im.C, cam, setup.max_view, index=cells)
         if not len(sub):
             return None
         idx = cells[sub]
-        gsd = float(np.median(dist)) / cam.fx
+        # median distance from a regular subsample (the buffer scale and image level need no more)
+        gsd = float(np.median(dist[:: max(1, len(dist) // 4096)])) / cam.fx
         scale = min(1.0, setup.oversample * gsd / res) if setup.visibility else 1.0
         zb = win = None
         if setup.visibility:
@@ -496,4 +501,52 @@ def tile_views(
     uv = uv.reshape(K, rows, cols, 2)
     eff = eff.reshape(K, rows, cols)
     gsd = np.array([results[i][4] for i in keep])
-    return TileViews(outer, h, cand_all[keep], usable, edge, uv, eff, gsd, 0 if tris is None else len(tris))
+    cands = cand_all[keep]
+    if setup.top_views > 0 and K > setup.top_views:
+        # candidates among the best ``top_views`` of no cell are dropped: a cell starts from its best
+        # image (or its roof's), and a seam move only takes a neighbour's label; kept are also the
+        # images neighbouring tiles chose here (their roofs continue)
+        best = np.zeros(K, np.bool_)
+        _mark_top(eff, usable, int(setup.top_views), best)
+        if prefer is not None and len(prefer):
+            best |= np.isin(cands, np.asarray(prefer))
+        if not best.all():
+            sel = np.flatnonzero(best)
+            usable, edge, uv, eff, gsd, cands = (
+                usable[sel],
+                edge[sel],
+                uv[sel],
+                eff[sel],
+                gsd[sel],
+                cands[sel],
+            )
+    return TileViews(outer, h, cands, usable, edge, uv, eff, gsd, 0 if tris is None else len(tris))
+
+
+@njit
+def _mark_top(eff, usable, m, out):
+    """``out[k]`` = candidate k has one of the ``m`` smallest ``eff`` among the usable at some cell."""
+    K, rows, cols = usable.shape
+    buf = np.empty(m)
+    for r in range(rows):
+        for c in range(cols):
+            n = 0  # the m smallest values so far, sorted, in buf[:n]
+            for k in range(K):
+                if not usable[k, r, c]:
+                    continue
+                v = eff[k, r, c]
+                if n == m and v >= buf[m - 1]:
+                    continue
+                j = n if n < m else m - 1
+                while j > 0 and buf[j - 1] > v:
+                    buf[j] = buf[j - 1]
+                    j -= 1
+                buf[j] = v
+                if n < m:
+                    n += 1
+            if n == 0:
+                continue
+            thr = buf[n - 1]
+            for k in range(K):
+                if usable[k, r, c] and eff[k, r, c] <= thr:
+                    out[k] = True

@@ -225,6 +225,26 @@ def scaled_params(camera: Camera, scale: float) -> np.ndarray:
 
 
 def valid_radius2(camera: Camera, margin: float = 3.0) -> float:
+    """Largest squared normalised radius where the distortion model is trusted (memoised, see
+    :func:`_valid_radius2`)."""
+    key = (tuple(float(v) for v in np.asarray(camera.params).ravel()), int(camera.width), int(camera.height))
+    return _valid_radius2_cached(key, float(margin), camera)
+
+
+_R2_CACHE: dict = {}
+
+
+def _valid_radius2_cached(key, margin: float, camera: Camera) -> float:
+    k = (key, margin)
+    v = _R2_CACHE.get(k)
+    if v is None:
+        if len(_R2_CACHE) > 4096:
+            _R2_CACHE.clear()
+        v = _R2_CACHE[k] = _valid_radius2(camera, margin)
+    return v
+
+
+def _valid_radius2(camera: Camera, margin: float = 3.0) -> float:
     """Largest squared normalised radius where the distortion model is trusted.
 
     ``margin`` times the radius of the farthest image corner (faces reaching
@@ -513,18 +533,19 @@ def depth_tolerance(res: float, pixel_footprint, tan_view, factor: float = 1.0, 
 
 
 @njit
-def _frame_pass(P, R, C, p, r2max, width, height, cos_max, u_out, v_out, dist_out):
-    """Cells in front, inside the frame and within the viewing angle: 1, else 0 (returned array)."""
-    n = P.shape[0]
+def _frame_pass(P, index, R, C, p, r2max, width, height, cos_max, u_out, v_out, dist_out):
+    """Points ``P[index[i]]`` in front, inside the frame and within the viewing angle: 1, else 0."""
+    n = index.shape[0]
     ok = np.zeros(n, np.uint8)
     for i in range(n):
-        dx = C[0] - P[i, 0]
-        dy = C[1] - P[i, 1]
-        dz = C[2] - P[i, 2]
+        j = index[i]
+        dx = C[0] - P[j, 0]
+        dy = C[1] - P[j, 1]
+        dz = C[2] - P[j, 2]
         dist = math.sqrt(dx * dx + dy * dy + dz * dz)
         if dist <= 0.0 or dz / dist < cos_max:
             continue
-        u, v, z = _proj(P[i, 0], P[i, 1], P[i, 2], R, C, p, r2max)
+        u, v, z = _proj(P[j, 0], P[j, 1], P[j, 2], R, C, p, r2max)
         if z <= 0.0 or u < -0.5 or v < -0.5 or u > width - 0.5 or v > height - 0.5:
             continue
         ok[i] = 1
@@ -615,19 +636,23 @@ def _view_pass(
         eff[m] = dist / (fx * cos_inc)
 
 
-def frame_cells(points, R, C, camera: Camera, max_view_rad: float):
+def frame_cells(points, R, C, camera: Camera, max_view_rad: float, index=None):
     """Cells seen inside the frame, in front, within the viewing angle.
 
-    Returns ``(index (m,) int, uv (m, 2) float64 full-resolution pixels, distance (m,) metres)``.
+    ``index`` (optional): the rows of ``points`` to test (default all).
+    Returns ``(index (m,) int, uv (m, 2) float64 full-resolution pixels, distance (m,) metres)``;
+    the returned index counts in ``index`` when given (positions in it), else in ``points``.
     """
     Rm, Cv = _pose(R, C)
     P = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
-    n = len(P)
+    ix = np.arange(len(P)) if index is None else np.ascontiguousarray(np.asarray(index, dtype=np.int64))
+    n = len(ix)
     u = np.empty(n)
     v = np.empty(n)
     d = np.empty(n)
     ok = _frame_pass(
         P,
+        ix,
         Rm,
         Cv,
         camera.params,

@@ -174,25 +174,60 @@ class _Base:
 
 
 class InProcessExecutor(_Base):
-    """Tasks one after another in this process, in task order (numba threads inside)."""
+    """Tasks in this process, in task order (numba threads inside).
+
+    ``threads`` > 1 runs up to that many tasks of one call at a time in a thread pool (the
+    numba kernels release the GIL); only for task functions that are thread-safe. Results are
+    still stored in task order, so they do not depend on the threads.
+    """
 
     name = "inprocess"
 
+    def __init__(self, threads: int = 1) -> None:
+        self.threads = max(1, int(threads))
+
     def _run(self, fn, n, materialise, store, shared, progress, memory=None) -> None:
         global _cancel_hook
-        for i in range(n):
-            got = materialise(i)
-            if got is None:
-                continue
-            task, k = got
-            previous, _cancel_hook = _cancel_hook, progress.cancelled
+
+        def call(task):
+            return fn(task) if shared is None else fn(shared, task)
+
+        previous, _cancel_hook = _cancel_hook, progress.cancelled
+        try:
+            if self.threads > 1 and n > 1:
+                self._run_threads(call, n, materialise, store, progress)
+                return
+            for i in range(n):
+                got = materialise(i)
+                if got is None:
+                    continue
+                task, k = got
+                value = call(task)
+                if progress.cancelled():
+                    raise CancelledError("cancelled by the user")
+                store(i, k, value)
+        finally:
+            _cancel_hook = previous
+
+    def _run_threads(self, call, n, materialise, store, progress) -> None:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(max_workers=self.threads) as pool:
+            futures = []
+            for i in range(n):
+                got = materialise(i)
+                if got is not None:
+                    futures.append((i, got[1], pool.submit(call, got[0])))
             try:
-                value = fn(task) if shared is None else fn(shared, task)
-            finally:
-                _cancel_hook = previous
-            if progress.cancelled():
-                raise CancelledError("cancelled by the user")
-            store(i, k, value)
+                for i, k, f in futures:  # in task order
+                    value = f.result()
+                    if progress.cancelled():
+                        raise CancelledError("cancelled by the user")
+                    store(i, k, value)
+            except BaseException:
+                for _i, _k, f in futures:
+                    f.cancel()
+                raise
 
 
 def _identity(x):
