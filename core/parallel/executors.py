@@ -210,22 +210,29 @@ class InProcessExecutor(_Base):
             _cancel_hook = previous
 
     def _run_threads(self, call, n, materialise, store, progress) -> None:
+        """At most 2 x threads tasks in flight (a cancel stops scheduling), stored in task order."""
+        from collections import deque
         from concurrent.futures import ThreadPoolExecutor
 
+        inflight: deque = deque()
+        nxt = 0
         with ThreadPoolExecutor(max_workers=self.threads) as pool:
-            futures = []
-            for i in range(n):
-                got = materialise(i)
-                if got is not None:
-                    futures.append((i, got[1], pool.submit(call, got[0])))
             try:
-                for i, k, f in futures:  # in task order
+                while nxt < n or inflight:
+                    while nxt < n and len(inflight) < 2 * self.threads:
+                        got = materialise(nxt)  # raises CancelledError once cancelled
+                        if got is not None:
+                            inflight.append((nxt, got[1], pool.submit(call, got[0])))
+                        nxt += 1
+                    if not inflight:
+                        continue
+                    i, k, f = inflight.popleft()
                     value = f.result()
                     if progress.cancelled():
                         raise CancelledError("cancelled by the user")
                     store(i, k, value)
             except BaseException:
-                for _i, _k, f in futures:
+                for _i, _k, f in inflight:
                     f.cancel()
                 raise
 

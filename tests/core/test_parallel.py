@@ -249,6 +249,27 @@ def test_in_process_executor_keeps_task_order_caches_and_cancels(tmp_path):
     assert calls == [1]
 
 
+def test_in_process_threads_keep_task_order_and_stop_on_cancel():
+    import threading
+
+    ex = InProcessExecutor(threads=2)
+    names = set()
+
+    def slow_square(x):
+        names.add(threading.current_thread().name)
+        time.sleep(0.02 * (5 - x))  # later tasks finish first
+        return x * x
+
+    seen = []
+    out = ex.map_tiles(slow_square, [1, 2, 3, 4], CallbackProgress(lambda f, m: seen.append(m)), label="t")
+    assert out == [1, 4, 9, 16] and seen[-1] == "t: tile 4/4" and len(names) == 2
+    calls = []
+    with pytest.raises(CancelledError):
+        stop = CallbackProgress(None, lambda: len(calls) >= 1)
+        ex.map_tiles(lambda x: calls.append(x), list(range(20)), stop)
+    assert 1 <= len(calls) <= 4  # at most 2 x threads tasks were in flight when the cancel came
+
+
 def test_tile_cache_is_exact_atomic_and_robust(tmp_path):
     c = TileCache(tmp_path / "t")
     k = Digest("a", np.arange(3)).hexdigest()
