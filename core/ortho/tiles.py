@@ -46,7 +46,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..grid import RasterGrid, Tile
-from ..parallel import Digest, current_cancel
+from ..parallel import Digest, current_cancel, tune_worker_malloc
 from .color import ColorCorrection
 from .mosaic import ImageStore, MosaicParams, mosaic_tile, to_dtype
 from .surface import PlanTransform
@@ -130,6 +130,7 @@ def ortho_tile_task(ctx: OrthoContext, task: OrthoTask):
     """
     from ..errors import CancelledError
 
+    tune_worker_malloc()
     tile = task.tile
     cancel = current_cancel()
     if cancel is not None and cancel():

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..parallel import Digest, current_cancel, file_identity
+from ..parallel import Digest, current_cancel, file_identity, tune_worker_malloc
 from .matching import TileParams, View, match_tile
 from .views import ImagePyramid
 
@@ -146,6 +146,7 @@ def worker_pyramid(ctx: TileContext) -> ImagePyramid:
 
 def osgm_tile_task(ctx: TileContext, task: TileTask) -> tuple[np.ndarray, np.ndarray]:
     """Match one tile; ``(z, confidence)`` of its core cells (float32, NaN where rejected)."""
+    tune_worker_malloc()
     res = match_tile(
         ctx.views,
         worker_pyramid(ctx),

@@ -16,6 +16,7 @@ from .executors import (
     make_executor,
     parse_memory,
     task_cancelled,
+    tune_worker_malloc,
 )
 
 __all__ = [
@@ -33,4 +34,5 @@ __all__ = [
     "make_executor",
     "parse_memory",
     "task_cancelled",
+    "tune_worker_malloc",
 ]

@@ -90,7 +90,7 @@ import numpy as np
 from ..errors import InputError
 from ..grid import RasterGrid
 from ..jit import pjit, prange
-from ..parallel import Digest, Executor, InProcessExecutor, TileCache, file_identity
+from ..parallel import Digest, Executor, InProcessExecutor, TileCache, file_identity, tune_worker_malloc
 from ..progress import Progress, Steps, as_progress
 
 #: half side of the window of the confidence pass (15 x 15 cells)
@@ -781,6 +781,7 @@ def filter_pass1_task(ctx: FilterContext, task: Pass1Task) -> tuple[np.ndarray, 
     (4-connected) its largest width (cells, float64) and its cell count (int64); the labels of
     the core's four border lines (int32).
     """
+    tune_worker_malloc()
     from scipy import ndimage
 
     cfg = ctx.config
@@ -813,6 +814,7 @@ def filter_pass2_task(ctx: FilterContext, task: Pass2Task) -> tuple[np.ndarray, 
     Returns ``(core, counts)``: the filtered core (float32, NaN = nodata) and int64 [smoothed,
     valid output] over the core.
     """
+    tune_worker_malloc()
     from scipy import ndimage
 
     cfg = ctx.config
