@@ -4,192 +4,192 @@
     <context>
         <name>TruOrtho</name>
         <message>
-            <location filename="../processing/algorithms/base.py" line="10" />
+            <location filename="../processing/algorithms/base.py" line="16" />
             <source>Orientation</source>
             <translation>Orientierung</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="10" />
+            <location filename="../processing/algorithms/base.py" line="16" />
             <source>Orthophoto</source>
             <translation>Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="10" />
+            <location filename="../processing/algorithms/base.py" line="16" />
             <source>Surface</source>
             <translation>Oberfläche</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="10" />
+            <location filename="../processing/algorithms/base.py" line="16" />
             <source>Tools</source>
             <translation>Werkzeuge</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="57" />
-            <source>Ground control points</source>
-            <translation>Passpunkte</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/base.py" line="63" />
-            <source>GCP image measurements (table)</source>
-            <translation>Bildmessungen der Passpunkte (Tabelle)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="34" />
-            <source>Filter DSM (outliers, holes, smoothing, DTM)</source>
-            <translation>DOM filtern (Ausreißer, Lücken, Glättung, DGM)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="284" />
-            <source>Filtered DSM</source>
-            <translation>Gefiltertes DOM</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="67" />
-            <source>Raw DSM</source>
-            <translation>Rohes DOM</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="69" />
-            <source>Confidence raster [0, 1]</source>
-            <translation>Konfidenzraster [0, 1]</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="74" />
-            <source>Outlier threshold (m; empty = 4 x resolution)</source>
-            <translation>Ausreißerschwelle (m; leer = 4 x Auflösung)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="81" />
-            <source>Largest hole width filled (m)</source>
-            <translation>Größte gefüllte Lückenbreite (m)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="82" />
-            <source>Sharpen blurred height steps</source>
-            <translation>Verschliffene Höhensprünge schärfen</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="85" />
-            <source>Edge-preserving smoothing of planar surfaces</source>
-            <translation>Kantenerhaltende Glättung ebener Flächen</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="91" />
-            <source>Outlier window (cells, odd)</source>
-            <translation>Ausreißerfenster (Zellen, ungerade)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="100" />
-            <source>Supporting neighbours that keep a cell</source>
-            <translation>Stützende Nachbarn, die eine Zelle erhalten</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="104" />
-            <source>Minimum confidence</source>
-            <translation>Mindestkonfidenz</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="110" />
-            <source>Confident cells (confidence at least)</source>
-            <translation>Zuverlässige Zellen (Konfidenz mindestens)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="119" />
-            <source>Height step between surfaces (m)</source>
-            <translation>Höhensprung zwischen Oberflächen (m)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="123" />
-            <source>Smoothing radius (cells)</source>
-            <translation>Glättungsradius (Zellen)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="129" />
-            <source>Smoothing height tolerance (m; empty = 2.5 x resolution)</source>
-            <translation>Höhentoleranz der Glättung (m; leer = 2,5 x Auflösung)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="140" />
-            <source>Ground filter cell size (m; empty = max(1 m, resolution))</source>
-            <translation>Zellgröße des Bodenfilters (m; leer = max(1 m, Auflösung))</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="149" />
-            <source>Ground filter window radius (m)</source>
-            <translation>Fensterradius des Bodenfilters (m)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="153" />
-            <source>Ground filter slope (rise/run)</source>
-            <translation>Neigung des Bodenfilters (Höhe/Strecke)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="159" />
+            <location filename="../processing/algorithms/base.py" line="71" />
             <source>Run tiles on</source>
             <translation>Kacheln ausführen auf</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="174" />
+            <location filename="../processing/algorithms/base.py" line="84" />
             <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
             <translation>Adresse des Dask-Schedulers (tls://host:port oder Scheduler-Datei; leer = TRUORTHO_DASK_SCHEDULER)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="186" />
-            <source>Terrain model (DTM)</source>
-            <translation>Geländemodell (DGM)</translation>
+            <location filename="../processing/algorithms/base.py" line="104" />
+            <source>Ground control points</source>
+            <translation>Passpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="191" />
-            <source>Normalised DSM (height above terrain)</source>
-            <translation>Normalisiertes DOM (Höhe über Gelände)</translation>
+            <location filename="../processing/algorithms/base.py" line="110" />
+            <source>GCP image measurements (table)</source>
+            <translation>Bildmessungen der Passpunkte (Tabelle)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="194" />
-            <source>Statistics (JSON)</source>
-            <translation>Statistik (JSON)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="195" />
-            <source>Outliers removed (cells)</source>
-            <translation>Entfernte Ausreißer (Zellen)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="196" />
-            <source>Hole cells filled</source>
-            <translation>Gefüllte Lückenzellen</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="197" />
-            <source>Holes left as nodata</source>
-            <translation>Als NoData verbliebene Lücken</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="286" />
-            <source>DTM</source>
-            <translation>DGM</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="161" />
+            <location filename="../processing/algorithms/base.py" line="73" />
             <source>inprocess: this process (all cores)</source>
             <translation>inprocess: dieser Prozess (alle Kerne)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <location filename="../processing/algorithms/base.py" line="74" />
             <source>local: a Dask cluster of worker processes on this computer</source>
             <translation>local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="163" />
+            <location filename="../processing/algorithms/base.py" line="75" />
             <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
             <translation>scheduler: ein Dask-Scheduler (SCHEDULER_ADDRESS)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="246" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="32" />
+            <source>Filter DSM (outliers, holes, smoothing, DTM)</source>
+            <translation>DOM filtern (Ausreißer, Lücken, Glättung, DGM)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="255" />
+            <source>Filtered DSM</source>
+            <translation>Gefiltertes DOM</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="64" />
+            <source>Raw DSM</source>
+            <translation>Rohes DOM</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="66" />
+            <source>Confidence raster [0, 1]</source>
+            <translation>Konfidenzraster [0, 1]</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="71" />
+            <source>Outlier threshold (m; empty = 4 x resolution)</source>
+            <translation>Ausreißerschwelle (m; leer = 4 x Auflösung)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="78" />
+            <source>Largest hole width filled (m)</source>
+            <translation>Größte gefüllte Lückenbreite (m)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="79" />
+            <source>Sharpen blurred height steps</source>
+            <translation>Verschliffene Höhensprünge schärfen</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="82" />
+            <source>Edge-preserving smoothing of planar surfaces</source>
+            <translation>Kantenerhaltende Glättung ebener Flächen</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="88" />
+            <source>Outlier window (cells, odd)</source>
+            <translation>Ausreißerfenster (Zellen, ungerade)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="97" />
+            <source>Supporting neighbours that keep a cell</source>
+            <translation>Stützende Nachbarn, die eine Zelle erhalten</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="101" />
+            <source>Minimum confidence</source>
+            <translation>Mindestkonfidenz</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="107" />
+            <source>Confident cells (confidence at least)</source>
+            <translation>Zuverlässige Zellen (Konfidenz mindestens)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="116" />
+            <source>Height step between surfaces (m)</source>
+            <translation>Höhensprung zwischen Oberflächen (m)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="120" />
+            <source>Smoothing radius (cells)</source>
+            <translation>Glättungsradius (Zellen)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="126" />
+            <source>Smoothing height tolerance (m; empty = 2.5 x resolution)</source>
+            <translation>Höhentoleranz der Glättung (m; leer = 2,5 x Auflösung)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="137" />
+            <source>Ground filter cell size (m; empty = max(1 m, resolution))</source>
+            <translation>Zellgröße des Bodenfilters (m; leer = max(1 m, Auflösung))</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="146" />
+            <source>Ground filter window radius (m)</source>
+            <translation>Fensterradius des Bodenfilters (m)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="150" />
+            <source>Ground filter slope (rise/run)</source>
+            <translation>Neigung des Bodenfilters (Höhe/Strecke)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="157" />
+            <source>Terrain model (DTM)</source>
+            <translation>Geländemodell (DGM)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <source>Normalised DSM (height above terrain)</source>
+            <translation>Normalisiertes DOM (Höhe über Gelände)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="165" />
+            <source>Statistics (JSON)</source>
+            <translation>Statistik (JSON)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="166" />
+            <source>Outliers removed (cells)</source>
+            <translation>Entfernte Ausreißer (Zellen)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="167" />
+            <source>Hole cells filled</source>
+            <translation>Gefüllte Lückenzellen</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="168" />
+            <source>Holes left as nodata</source>
+            <translation>Als NoData verbliebene Lücken</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="257" />
+            <source>DTM</source>
+            <translation>DGM</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="217" />
             <source>{} holes ({} cells, widest {:.1f} m) are wider than {} m and stay nodata</source>
             <translation>{} Lücken ({} Zellen, breiteste {:.1f} m) sind breiter als {} m und bleiben NoData</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="274" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="245" />
             <source>Ground filter at {:.2f} m: {:.1f} % of the cells are ground</source>
             <translation>Bodenfilter mit {:.2f} m: {:.1f} % der Zellen sind Boden</translation>
         </message>
@@ -584,217 +584,217 @@
             <translation>IMAGES: {} ist kein Ordner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="39" />
+            <location filename="../processing/algorithms/osgm.py" line="38" />
             <source>Dense matching (OSGM)</source>
             <translation>Dichte Bildzuordnung (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="308" />
+            <location filename="../processing/algorithms/osgm.py" line="280" />
             <source>DSM (OSGM)</source>
             <translation>DOM (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="74" />
+            <location filename="../processing/algorithms/osgm.py" line="72" />
             <source>Extent (default: the area seen by the images)</source>
             <translation>Ausdehnung (Standard: der von den Bildern gesehene Bereich)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="80" />
+            <location filename="../processing/algorithms/osgm.py" line="78" />
             <source>Resolution (m; empty or 0 = median ground sample distance)</source>
             <translation>Auflösung (m; leer oder 0 = mittlere Bodenpixelgröße)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="90" />
+            <location filename="../processing/algorithms/osgm.py" line="88" />
             <source>Height step of the search (m; empty or 0 = the resolution)</source>
             <translation>Höhenschritt der Suche (m; leer oder 0 = die Auflösung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="100" />
+            <location filename="../processing/algorithms/osgm.py" line="98" />
             <source>Lowest height searched (m; empty = automatic)</source>
             <translation>Niedrigste gesuchte Höhe (m; leer = automatisch)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="109" />
+            <location filename="../processing/algorithms/osgm.py" line="107" />
             <source>Highest height searched (m; empty = automatic)</source>
             <translation>Höchste gesuchte Höhe (m; leer = automatisch)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="117" />
+            <location filename="../processing/algorithms/osgm.py" line="115" />
             <source>Coarse surface bounding the search per cell (DSM/DTM)</source>
             <translation>Grobe Oberfläche, die die Suche je Zelle begrenzt (DOM/DGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="123" />
+            <location filename="../processing/algorithms/osgm.py" line="121" />
             <source>Aggregation paths</source>
             <translation>Aggregationspfade</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="131" />
+            <location filename="../processing/algorithms/osgm.py" line="129" />
             <source>Oblique images</source>
             <translation>Schrägbilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="139" />
+            <location filename="../processing/algorithms/osgm.py" line="137" />
             <source>Penalty P1, one height step (cost units; empty = default)</source>
             <translation>Strafterm P1, ein Höhenschritt (Kosteneinheiten; leer = Standard)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="150" />
+            <location filename="../processing/algorithms/osgm.py" line="148" />
             <source>Penalty P2, larger height jumps (cost units; empty = default)</source>
             <translation>Strafterm P2, größere Höhensprünge (Kosteneinheiten; leer = Standard)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="159" />
+            <location filename="../processing/algorithms/osgm.py" line="157" />
             <source>Images per tile (at most)</source>
             <translation>Bilder pro Kachel (höchstens)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="163" />
+            <location filename="../processing/algorithms/osgm.py" line="161" />
             <source>Tile size (cells)</source>
             <translation>Kachelgröße (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="196" />
+            <location filename="../processing/algorithms/osgm.py" line="168" />
             <source>Confidence [0, 1]</source>
             <translation>Konfidenz [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="201" />
+            <location filename="../processing/algorithms/osgm.py" line="173" />
             <source>Orthoimage (matching colours)</source>
             <translation>Orthobild (Farben der Zuordnung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="207" />
+            <location filename="../processing/algorithms/osgm.py" line="179" />
             <source>Point cloud</source>
             <translation>Punktwolke</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="232" />
+            <location filename="../processing/algorithms/osgm.py" line="204" />
             <source>EXTENT: the extent is empty</source>
             <translation>EXTENT: die Ausdehnung ist leer</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="311" />
+            <location filename="../processing/algorithms/osgm.py" line="283" />
             <source>Confidence (OSGM)</source>
             <translation>Konfidenz (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="314" />
+            <location filename="../processing/algorithms/osgm.py" line="286" />
             <source>Orthoimage (OSGM)</source>
             <translation>Orthobild (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="132" />
+            <location filename="../processing/algorithms/osgm.py" line="130" />
             <source>none: one nadir reference system</source>
             <translation>none: ein Nadir-Referenzsystem</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="132" />
+            <location filename="../processing/algorithms/osgm.py" line="130" />
             <source>auto: extra systems for obliques</source>
             <translation>auto: zusätzliche Systeme für Schrägbilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="245" />
+            <location filename="../processing/algorithms/osgm.py" line="217" />
             <source>ORIENTATION: the file {!r} does not exist</source>
             <translation>ORIENTATION: die Datei {!r} existiert nicht</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="257" />
+            <location filename="../processing/algorithms/osgm.py" line="229" />
             <source>Z_MIN ({}) must be below Z_MAX ({})</source>
             <translation>Z_MIN ({}) muss unter Z_MAX ({}) liegen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="273" />
+            <location filename="../processing/algorithms/osgm.py" line="245" />
             <source>POINT_CLOUD: expected a .las or .laz file, got {!r}</source>
             <translation>POINT_CLOUD: .las- oder .laz-Datei erwartet, erhalten: {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="252" />
+            <location filename="../processing/algorithms/osgm.py" line="224" />
             <source>{}: must be positive (or empty), got {}</source>
             <translation>{}: muss positiv (oder leer) sein, erhalten: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="263" />
+            <location filename="../processing/algorithms/osgm.py" line="235" />
             <source>Z_SURFACE: expected a raster file (GeoTIFF), got {!r}</source>
             <translation>Z_SURFACE: Rasterdatei (GeoTIFF) erwartet, erhalten: {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="31" />
+            <location filename="../processing/algorithms/pipeline.py" line="29" />
             <source>Photos to true orthophoto (whole pipeline)</source>
             <translation>Fotos zum True Orthophoto (gesamte Prozesskette)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="117" />
+            <location filename="../processing/algorithms/pipeline.py" line="88" />
             <source>DSM (filtered)</source>
             <translation>DOM (gefiltert)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="120" />
+            <location filename="../processing/algorithms/pipeline.py" line="91" />
             <source>True orthophoto</source>
             <translation>True Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="121" />
+            <location filename="../processing/algorithms/pipeline.py" line="92" />
             <source>Occlusion mask</source>
             <translation>Verdeckungsmaske</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="122" />
+            <location filename="../processing/algorithms/pipeline.py" line="93" />
             <source>Seamlines</source>
             <translation>Nahtlinien</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="75" />
+            <location filename="../processing/algorithms/pipeline.py" line="72" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Auflösung des DOM und des True Orthophotos (m, 0 = Bodenpixelgröße)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="83" />
+            <location filename="../processing/algorithms/pipeline.py" line="80" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Eine vorhandene orientation.json im Ausgabeordner wiederverwenden</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="137" />
+            <location filename="../processing/algorithms/pipeline.py" line="108" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES: geben Sie den Ordner der Fotos an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="152" />
+            <location filename="../processing/algorithms/pipeline.py" line="123" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER: geben Sie einen Ordner für die Produkte an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="162" />
+            <location filename="../processing/algorithms/pipeline.py" line="133" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION: positive Anzahl Meter oder 0 erwartet</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="196" />
+            <location filename="../processing/algorithms/pipeline.py" line="167" />
             <source>DSM (TruOrtho)</source>
             <translation>DOM (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="197" />
+            <location filename="../processing/algorithms/pipeline.py" line="168" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>True Orthophoto (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="198" />
+            <location filename="../processing/algorithms/pipeline.py" line="169" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Verdeckung (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="199" />
+            <location filename="../processing/algorithms/pipeline.py" line="170" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Nahtlinien (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="182" />
+            <location filename="../processing/algorithms/pipeline.py" line="153" />
             <source>Tiles ran on: {}</source>
             <translation>Kacheln berechnet auf: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="181" />
+            <location filename="../processing/algorithms/pipeline.py" line="152" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{}: {:.1f} s, Spitze {:.0f} MB; {}</translation>
         </message>
@@ -869,62 +869,62 @@
             <translation>EPT-Datensatz: {} (als Punktwolken-Layer hinzufügen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="73" />
+            <location filename="../processing/algorithms/trueortho.py" line="68" />
             <source>Surface: DSM raster or mesh</source>
             <translation>Oberfläche: DOM-Raster oder Dreiecksnetz</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="78" />
+            <location filename="../processing/algorithms/trueortho.py" line="73" />
             <source>Extent (default: the surface's)</source>
             <translation>Ausdehnung (Standard: die der Oberfläche)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="83" />
+            <location filename="../processing/algorithms/trueortho.py" line="78" />
             <source>Resolution (CRS units; 0 = the surface's cell size)</source>
             <translation>Auflösung (KBS-Einheiten; 0 = Zellgröße der Oberfläche)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="90" />
+            <location filename="../processing/algorithms/trueortho.py" line="85" />
             <source>Output CRS (default: the orientation's)</source>
             <translation>Ausgabe-KBS (Standard: das der Orientierung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="92" />
+            <location filename="../processing/algorithms/trueortho.py" line="87" />
             <source>Colour correction</source>
             <translation>Farbausgleich</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="96" />
+            <location filename="../processing/algorithms/trueortho.py" line="91" />
             <source>Maximum off-nadir viewing angle (degrees)</source>
             <translation>Größter Blickwinkel zum Nadir (Grad)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="106" />
+            <location filename="../processing/algorithms/trueortho.py" line="101" />
             <source>Blend width across seamlines (cells)</source>
             <translation>Überblendungsbreite an den Nahtlinien (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="154" />
+            <location filename="../processing/algorithms/trueortho.py" line="123" />
             <source>Source image index</source>
             <translation>Index des Quellbilds</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="165" />
+            <location filename="../processing/algorithms/trueortho.py" line="134" />
             <source>Seamlines (source image regions)</source>
             <translation>Nahtlinien (Bereiche der Quellbilder)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="180" />
+            <location filename="../processing/algorithms/trueortho.py" line="149" />
             <source>SURFACE: give a DSM raster or a mesh file</source>
             <translation>SURFACE: geben Sie ein DOM-Raster oder eine Netzdatei an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="74" />
+            <location filename="../processing/algorithms/trueortho.py" line="69" />
             <source>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;All files (*.*)</source>
             <translation>Oberflächen (*.tif *.tiff *.vrt *.ply *.obj);;Alle Dateien (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="210" />
+            <location filename="../processing/algorithms/trueortho.py" line="179" />
             <source>{} x {} cells, {} images used, coverage {:.2%}, {} cells seen by no image</source>
             <translation>{} x {} Zellen, {} Bilder verwendet, Abdeckung {:.2%}, {} Zellen von keinem Bild gesehen</translation>
         </message>
@@ -934,362 +934,362 @@
             <translation>Vom Benutzer abgebrochen</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="16" />
-            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
-            <translation>Importiert die Orientierung eines Bildverbands (innere und äußere Orientierung jedes Bildes, dünne Punktwolke) aus COLMAP-, Orthority- oder OpenSfM/ODM-Dateien in das Orientierungs-JSON von TruOrtho und schreibt einen Layer der Projektionszentren und einen Layer der Bildabdeckungen. Konventionen (Kameraachsen, Rotationen, Pixelursprung) werden beim Import umgerechnet; siehe README, 'Formats and conventions'.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="24" />
-            <source>COLMAP text model (cameras.txt, images.txt or points3D.txt; the folder is used, with an optional georef.json {"crs": ..., "offset": [E, N, H]}), Orthority exterior CSV (filename, x, y, z, omega, phi, kappa[, camera]; degrees), OpenSfM/ODM reconstruction.json, or a TruOrtho orientation JSON.</source>
-            <translation>COLMAP-Textmodell (cameras.txt, images.txt oder points3D.txt; verwendet wird der Ordner, mit einer optionalen georef.json {"crs": ..., "offset": [E, N, H]}), Orthority-CSV der äußeren Orientierung (filename, x, y, z, omega, phi, kappa[, camera]; Grad), OpenSfM/ODM-reconstruction.json oder ein TruOrtho-Orientierungs-JSON.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="29" />
-            <source>Orthority interior parameter file (YAML or JSON); required with a CSV input.</source>
-            <translation>Orthority-Parameterdatei der inneren Orientierung (YAML oder JSON); bei einer CSV-Eingabe erforderlich.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="30" />
-            <source>CRS of the input coordinates when the file does not state it (CSV without .prj, COLMAP without georef.json); target CRS for OpenSfM's topocentric frame.</source>
-            <translation>KBS der Eingabekoordinaten, wenn die Datei es nicht angibt (CSV ohne .prj, COLMAP ohne georef.json); Ziel-KBS für das topozentrische System von OpenSfM.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="32" />
-            <source>Folder holding the images; every image of the block must be present there.</source>
-            <translation>Ordner mit den Bildern; jedes Bild des Verbands muss dort vorhanden sein.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="33" />
-            <source>Optional ground control: point layer with 'name', 'role' (gcp|check), PointZ or a 'z' field, optional 'sigma_xy'/'sigma_z' in metres. Reprojected to the orientation's CRS.</source>
-            <translation>Optionale Passpunkte: Punktlayer mit 'name', 'role' (gcp|check), PointZ oder einem Feld 'z', optional 'sigma_xy'/'sigma_z' in Metern. Wird in das KBS der Orientierung umprojiziert.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="35" />
-            <source>Image measurements of the GCPs: table with 'gcp', 'image', 'x', 'y' in pixels ((0, 0) = centre of the top-left pixel).</source>
-            <translation>Bildmessungen der Passpunkte: Tabelle mit 'gcp', 'image', 'x', 'y' in Pixeln ((0, 0) = Mitte des linken oberen Pixels).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="37" />
-            <source>Height (in the CRS) of the plane the footprints are drawn on; default the median height of the sparse points, or of the GCPs, or 0.</source>
-            <translation>Höhe (im KBS) der Ebene, auf der die Bildabdeckungen gezeichnet werden; Standard ist die mittlere Höhe (Median) der dünnen Punktwolke, sonst der Passpunkte, sonst 0.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="39" />
-            <source>The orientation JSON (TruOrtho format, version 1).</source>
-            <translation>Das Orientierungs-JSON (TruOrtho-Format, Version 1).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="40" />
-            <source>Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees).</source>
-            <translation>Projektionszentren als PointZ mit name, camera, x, y, z, omega, phi, kappa (Grad).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="42" />
-            <source>Image footprints on the horizontal plane at FOOTPRINT_HEIGHT.</source>
-            <translation>Bildabdeckungen auf der horizontalen Ebene in Höhe FOOTPRINT_HEIGHT.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="47" />
-            <source>Exports a TruOrtho orientation JSON to a COLMAP text model (cameras.txt, images.txt, points3D.txt and georef.json) or to Orthority frame-camera files (exterior.csv with a .prj sidecar and interior.yaml).</source>
-            <translation>Exportiert ein TruOrtho-Orientierungs-JSON in ein COLMAP-Textmodell (cameras.txt, images.txt, points3D.txt und georef.json) oder in Orthority-Dateien für Rahmenkameras (exterior.csv mit einer .prj-Begleitdatei und interior.yaml).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="52" />
-            <source>A TruOrtho orientation JSON.</source>
-            <translation>Ein TruOrtho-Orientierungs-JSON.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="53" />
-            <source>colmap or opk (Orthority CSV + interior file).</source>
-            <translation>colmap oder opk (Orthority-CSV + Datei der inneren Orientierung).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="54" />
-            <source>Folder the files are written to (created if needed).</source>
-            <translation>Ordner, in den die Dateien geschrieben werden (wird bei Bedarf angelegt).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="59" />
-            <source>Reads an ODM/OpenSfM gcp_list.txt (first line EPSG code, PROJ string or 'WGS84 UTM nnX'; then 'X Y Z px py image [name]') into a GCP point layer and an observation table, the two inputs ground control takes everywhere in TruOrtho.</source>
-            <translation>Liest eine ODM/OpenSfM-gcp_list.txt (erste Zeile EPSG-Code, PROJ-String oder 'WGS84 UTM nnX'; dann 'X Y Z px py image [name]') in einen Passpunkt-Punktlayer und eine Beobachtungstabelle ein, die beiden Eingaben, die Passpunkte überall in TruOrtho benötigen.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="64" />
-            <source>The gcp_list.txt file.</source>
-            <translation>Die Datei gcp_list.txt.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="65" />
-            <source>Comma-separated GCP names to mark as check points (role 'check').</source>
-            <translation>Kommagetrennte Passpunktnamen, die als Kontrollpunkte markiert werden (Rolle 'check').</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="66" />
-            <source>Default planimetric standard deviation of the GCP coordinates, metres.</source>
-            <translation>Standardabweichung der Lage der Passpunktkoordinaten (Standardwert), Meter.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="67" />
-            <source>Default height standard deviation of the GCP coordinates, metres.</source>
-            <translation>Standardabweichung der Höhe der Passpunktkoordinaten (Standardwert), Meter.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="68" />
-            <source>Optional CRS to reproject the GCPs to (default: the file's CRS).</source>
-            <translation>Optionales KBS, in das die Passpunkte umprojiziert werden (Standard: das KBS der Datei).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="69" />
-            <source>GCP point layer (PointZ): name, role, z, sigma_xy, sigma_z.</source>
-            <translation>Passpunkt-Punktlayer (PointZ): name, role, z, sigma_xy, sigma_z.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="70" />
-            <source>Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the top-left pixel, as in gcp_list.txt).</source>
-            <translation>Beobachtungstabelle: gcp, image, x, y (Pixel, (0, 0) = Mitte des linken oberen Pixels, wie in gcp_list.txt).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="76" />
-            <source>Orients a block of overlapping photos: SIFT features at a working resolution, pair selection (exhaustive for small blocks, EXIF GNSS footprints, or a low-resolution retrieval pass), robust two-view geometry, tie-point tracks decimated on a grid by multiplicity, incremental reconstruction and a bundle block adjustment written for TruOrtho (collinearity equations with Brown distortion, Levenberg-Marquardt with the Schur complement, Huber loss, self-calibration). Ground control fixes the datum (7-parameter similarity, then weighted GCP observations); check points never enter the adjustment and are reported with per-axis RMSE. Without GCPs, EXIF GNSS positions serve as weighted priors; without either the block stays in an arbitrary frame.</source>
-            <translation>Orientiert einen Verband überlappender Fotos: SIFT-Merkmale in einer Arbeitsauflösung, Paarauswahl (vollständig bei kleinen Verbänden, über EXIF-GNSS-Bildabdeckungen oder einen Suchlauf in niedriger Auflösung), robuste Zweibildgeometrie, Verknüpfungspunktspuren, auf einem Raster nach Vielfachheit ausgedünnt, inkrementelle Rekonstruktion und eine für TruOrtho geschriebene Bündelblockausgleichung (Kollinearitätsgleichungen mit Brown-Verzeichnung, Levenberg-Marquardt mit dem Schur-Komplement, Huber-Verlustfunktion, Selbstkalibrierung). Passpunkte legen das Datum fest (7-Parameter-Ähnlichkeitstransformation, dann gewichtete Passpunktbeobachtungen); Kontrollpunkte gehen nie in die Ausgleichung ein und werden mit dem RMSE je Achse berichtet. Ohne Passpunkte dienen EXIF-GNSS-Positionen als gewichtete Vorinformation; ohne beides bleibt der Verband in einem beliebigen System.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="86" />
-            <source>Folder of the images (non-image files are skipped with a warning in the report).</source>
-            <translation>Ordner der Bilder (Nicht-Bilddateien werden mit einer Warnung im Bericht übersprungen).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="87" />
-            <source>The image files, instead of a folder.</source>
-            <translation>Die Bilddateien, statt eines Ordners.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="88" />
-            <source>Interior orientation: an Orthority interior file (YAML/JSON) or a text file with the 3x3 matrix K, taken as a calibration and held fixed. Without it: EXIF focal length and sensor size, else f = 1.2 x max(w, h), refined by self-calibration.</source>
-            <translation>Innere Orientierung: eine Orthority-Datei der inneren Orientierung (YAML/JSON) oder eine Textdatei mit der 3x3-Matrix K, als Kalibrierung übernommen und festgehalten. Ohne sie: EXIF-Brennweite und Sensorgröße, sonst f = 1,2 x max(w, h), verfeinert durch Selbstkalibrierung.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="91" />
-            <source>Ground control and check points: point layer with 'name', 'role' (gcp|check), PointZ or 'z', optional 'sigma_xy'/'sigma_z' (metres). Reprojected to CRS.</source>
-            <translation>Pass- und Kontrollpunkte: Punktlayer mit 'name', 'role' (gcp|check), PointZ oder 'z', optional 'sigma_xy'/'sigma_z' (Meter). Wird in CRS umprojiziert.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="93" />
-            <source>Image measurements of the GCPs: table with 'gcp', 'image' (file name), 'x', 'y' (pixels, (0, 0) = centre of the top-left pixel).</source>
-            <translation>Bildmessungen der Passpunkte: Tabelle mit 'gcp', 'image' (Dateiname), 'x', 'y' (Pixel, (0, 0) = Mitte des linken oberen Pixels).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="95" />
-            <source>CRS of the output (default: the GCP layer's, else the UTM zone of the EXIF GNSS positions).</source>
-            <translation>KBS der Ausgabe (Standard: das des Passpunktlayers, sonst die UTM-Zone der EXIF-GNSS-Positionen).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="97" />
-            <source>Larger image side at which features are detected, pixels.</source>
-            <translation>Längere Bildseite, auf der die Merkmale detektiert werden, Pixel.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="98" />
-            <source>Features kept per image.</source>
-            <translation>Pro Bild behaltene Merkmale.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="99" />
-            <source>Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment when no CAMERA file is given (else hold the prior interior orientation).</source>
-            <translation>f, cx, cy, k1, k2, p1, p2 in der Ausgleichung schätzen, wenn keine CAMERA-Datei angegeben ist (sonst die vorgegebene innere Orientierung festhalten).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="101" />
-            <source>The adjusted orientation (TruOrtho JSON).</source>
-            <translation>Die ausgeglichene Orientierung (TruOrtho-JSON).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="102" />
-            <source>HTML report (and a JSON file of the same name): sigma0, image RMS, per-image residuals, GCP and check point tables, residual vector plots, tie-point multiplicity histogram, block overview.</source>
-            <translation>HTML-Bericht (und eine gleichnamige JSON-Datei): Sigma0, Bild-RMS, Residuen je Bild, Tabellen der Pass- und Kontrollpunkte, Residuenvektor-Grafiken, Histogramm der Vielfachheit der Verknüpfungspunkte, Verbandsübersicht.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="105" />
-            <source>Projection centres (PointZ) with omega, phi, kappa.</source>
-            <translation>Projektionszentren (PointZ) mit omega, phi, kappa.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="106" />
-            <source>Tie points (PointZ) with multiplicity, mean reprojection error and colour.</source>
-            <translation>Verknüpfungspunkte (PointZ) mit Vielfachheit, mittlerem Rückprojektionsfehler und Farbe.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="107" />
-            <source>GCPs and check points with dX, dY, dZ (adjusted or triangulated minus surveyed).</source>
-            <translation>Pass- und Kontrollpunkte mit dX, dY, dZ (ausgeglichen bzw. trianguliert minus gemessen).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="113" />
-            <source>The whole chain from photos to a true orthophoto in one run: image orientation with the ground control (bundle block adjustment), dense matching in object space (OSGM), DSM filtering, a mesh, and the true orthophoto with its occlusion mask and seamlines, plus one HTML report (block overview, sigma0, GCP and check point tables, residual plot, DSM hillshade, true-orthophoto preview, time and memory per stage). The products are written to OUTPUT_FOLDER with fixed names: orientation.json, report.html, dsm.tif, pointcloud.laz, mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (and the raw DSM, confidence and orthoimage of the matching).</source>
-            <translation>Die gesamte Prozesskette von Fotos zum True Orthophoto in einem Lauf: Bildorientierung mit den Passpunkten (Bündelblockausgleichung), dichte Bildzuordnung im Objektraum (OSGM), DOM-Filterung, eine Vermaschung und das True Orthophoto mit seiner Verdeckungsmaske und den Nahtlinien, dazu ein HTML-Bericht (Verbandsübersicht, Sigma0, Tabellen der Pass- und Kontrollpunkte, Residuengrafik, DOM-Schummerung, Vorschau des True Orthophotos, Zeit und Speicher je Schritt). Die Produkte werden mit festen Namen in OUTPUT_FOLDER geschrieben: orientation.json, report.html, dsm.tif, pointcloud.laz, mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (sowie das rohe DOM, die Konfidenz und das Orthobild der Zuordnung).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="123" />
-            <source>Folder of the photos (JPEG, TIFF, PNG...); other files are skipped.</source>
-            <translation>Ordner der Fotos (JPEG, TIFF, PNG...); andere Dateien werden übersprungen.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="124" />
-            <source>Optional interior orientation (Orthority YAML/JSON or a 3x3 K text file), held fixed; otherwise EXIF priors refined by self-calibration.</source>
-            <translation>Optionale innere Orientierung (Orthority-YAML/JSON oder eine Textdatei mit der 3x3-Matrix K), festgehalten; sonst EXIF-Vorwerte, verfeinert durch Selbstkalibrierung.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="126" />
-            <source>Optional point layer of ground control and check points (fields name, role gcp|check, optional z, sigma_xy, sigma_z), as for Orient images. Needed for a georeferenced product unless the photos carry EXIF GNSS positions.</source>
-            <translation>Optionaler Punktlayer der Pass- und Kontrollpunkte (Felder name, role gcp|check, optional z, sigma_xy, sigma_z), wie bei Bilder orientieren. Für ein georeferenziertes Produkt erforderlich, sofern die Fotos keine EXIF-GNSS-Positionen enthalten.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="129" />
-            <source>Table of the GCP image measurements (gcp, image, x, y), given with GCPS.</source>
-            <translation>Tabelle der Bildmessungen der Passpunkte (gcp, image, x, y), zusammen mit GCPS anzugeben.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="130" />
-            <source>CRS of the products; default the GCP layer's CRS.</source>
-            <translation>KBS der Produkte; Standard ist das KBS des Passpunktlayers.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="131" />
-            <source>Cell size of the DSM and the true orthophoto in metres; 0 = the median ground sample distance of the near-nadir images.</source>
-            <translation>Zellgröße des DOM und des True Orthophotos in Metern; 0 = mittlere Bodenpixelgröße (Median) der nadirnahen Bilder.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="133" />
-            <source>Skip the orientation when OUTPUT_FOLDER already holds orientation.json (e.g. to rerun matching and the orthophoto with another resolution).</source>
-            <translation>Die Orientierung überspringen, wenn OUTPUT_FOLDER bereits eine orientation.json enthält (z. B. um Zuordnung und Orthophoto mit einer anderen Auflösung erneut zu rechnen).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="135" />
-            <source>Where the tiles of dense matching, DSM filtering and the true orthophoto are computed, by one executor for the three stages (a local cluster starts once); the products are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the photos and OUTPUT_FOLDER at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The orientation, the mesh and the report are computed in QGIS's process. The address is checked before the orientation starts; the scheduler is first contacted by dense matching.</source>
-            <translation>Wo die Kacheln der dichten Bildzuordnung, der DOM-Filterung und des True Orthophotos berechnet werden, durch einen Executor für alle drei Schritte (ein lokaler Cluster startet nur einmal); die Produkte sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Fotos und OUTPUT_FOLDER unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Orientierung, Dreiecksnetz und Bericht werden im Prozess von QGIS berechnet. Die Adresse wird vor dem Start der Orientierung geprüft; der Scheduler wird erstmals von der dichten Bildzuordnung kontaktiert.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="145" />
+            <location filename="../processing/help/__init__.py" line="14" />
             <source>Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. Security: a Dask scheduler executes any code its clients send, so it must never be reachable unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address that is not on this computer is refused.</source>
             <translation>Adresse des Dask-Schedulers für EXECUTOR = scheduler: tls://host:8786 oder der Pfad einer Scheduler-Datei; leer = die Umgebungsvariable TRUORTHO_DASK_SCHEDULER. Sicherheit: Ein Dask-Scheduler führt jeden Code aus, den seine Clients senden, und darf daher nie ohne Authentifizierung erreichbar sein. Für einen entfernten Scheduler TLS mit Zertifikaten verwenden (in der Dask-Konfiguration, distributed.comm.tls) oder einen SSH-Tunnel nach 127.0.0.1; eine einfache tcp://-Adresse, die nicht auf diesem Rechner liegt, wird abgelehnt.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="151" />
+            <location filename="../processing/help/__init__.py" line="26" />
+            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
+            <translation>Importiert die Orientierung eines Bildverbands (innere und äußere Orientierung jedes Bildes, dünne Punktwolke) aus COLMAP-, Orthority- oder OpenSfM/ODM-Dateien in das Orientierungs-JSON von TruOrtho und schreibt einen Layer der Projektionszentren und einen Layer der Bildabdeckungen. Konventionen (Kameraachsen, Rotationen, Pixelursprung) werden beim Import umgerechnet; siehe README, 'Formats and conventions'.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="34" />
+            <source>COLMAP text model (cameras.txt, images.txt or points3D.txt; the folder is used, with an optional georef.json {"crs": ..., "offset": [E, N, H]}), Orthority exterior CSV (filename, x, y, z, omega, phi, kappa[, camera]; degrees), OpenSfM/ODM reconstruction.json, or a TruOrtho orientation JSON.</source>
+            <translation>COLMAP-Textmodell (cameras.txt, images.txt oder points3D.txt; verwendet wird der Ordner, mit einer optionalen georef.json {"crs": ..., "offset": [E, N, H]}), Orthority-CSV der äußeren Orientierung (filename, x, y, z, omega, phi, kappa[, camera]; Grad), OpenSfM/ODM-reconstruction.json oder ein TruOrtho-Orientierungs-JSON.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="39" />
+            <source>Orthority interior parameter file (YAML or JSON); required with a CSV input.</source>
+            <translation>Orthority-Parameterdatei der inneren Orientierung (YAML oder JSON); bei einer CSV-Eingabe erforderlich.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="40" />
+            <source>CRS of the input coordinates when the file does not state it (CSV without .prj, COLMAP without georef.json); target CRS for OpenSfM's topocentric frame.</source>
+            <translation>KBS der Eingabekoordinaten, wenn die Datei es nicht angibt (CSV ohne .prj, COLMAP ohne georef.json); Ziel-KBS für das topozentrische System von OpenSfM.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="42" />
+            <source>Folder holding the images; every image of the block must be present there.</source>
+            <translation>Ordner mit den Bildern; jedes Bild des Verbands muss dort vorhanden sein.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="43" />
+            <source>Optional ground control: point layer with 'name', 'role' (gcp|check), PointZ or a 'z' field, optional 'sigma_xy'/'sigma_z' in metres. Reprojected to the orientation's CRS.</source>
+            <translation>Optionale Passpunkte: Punktlayer mit 'name', 'role' (gcp|check), PointZ oder einem Feld 'z', optional 'sigma_xy'/'sigma_z' in Metern. Wird in das KBS der Orientierung umprojiziert.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="45" />
+            <source>Image measurements of the GCPs: table with 'gcp', 'image', 'x', 'y' in pixels ((0, 0) = centre of the top-left pixel).</source>
+            <translation>Bildmessungen der Passpunkte: Tabelle mit 'gcp', 'image', 'x', 'y' in Pixeln ((0, 0) = Mitte des linken oberen Pixels).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="47" />
+            <source>Height (in the CRS) of the plane the footprints are drawn on; default the median height of the sparse points, or of the GCPs, or 0.</source>
+            <translation>Höhe (im KBS) der Ebene, auf der die Bildabdeckungen gezeichnet werden; Standard ist die mittlere Höhe (Median) der dünnen Punktwolke, sonst der Passpunkte, sonst 0.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="49" />
+            <source>The orientation JSON (TruOrtho format, version 1).</source>
+            <translation>Das Orientierungs-JSON (TruOrtho-Format, Version 1).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="50" />
+            <source>Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees).</source>
+            <translation>Projektionszentren als PointZ mit name, camera, x, y, z, omega, phi, kappa (Grad).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="52" />
+            <source>Image footprints on the horizontal plane at FOOTPRINT_HEIGHT.</source>
+            <translation>Bildabdeckungen auf der horizontalen Ebene in Höhe FOOTPRINT_HEIGHT.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="57" />
+            <source>Exports a TruOrtho orientation JSON to a COLMAP text model (cameras.txt, images.txt, points3D.txt and georef.json) or to Orthority frame-camera files (exterior.csv with a .prj sidecar and interior.yaml).</source>
+            <translation>Exportiert ein TruOrtho-Orientierungs-JSON in ein COLMAP-Textmodell (cameras.txt, images.txt, points3D.txt und georef.json) oder in Orthority-Dateien für Rahmenkameras (exterior.csv mit einer .prj-Begleitdatei und interior.yaml).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="62" />
+            <source>A TruOrtho orientation JSON.</source>
+            <translation>Ein TruOrtho-Orientierungs-JSON.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="63" />
+            <source>colmap or opk (Orthority CSV + interior file).</source>
+            <translation>colmap oder opk (Orthority-CSV + Datei der inneren Orientierung).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="64" />
+            <source>Folder the files are written to (created if needed).</source>
+            <translation>Ordner, in den die Dateien geschrieben werden (wird bei Bedarf angelegt).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="69" />
+            <source>Reads an ODM/OpenSfM gcp_list.txt (first line EPSG code, PROJ string or 'WGS84 UTM nnX'; then 'X Y Z px py image [name]') into a GCP point layer and an observation table, the two inputs ground control takes everywhere in TruOrtho.</source>
+            <translation>Liest eine ODM/OpenSfM-gcp_list.txt (erste Zeile EPSG-Code, PROJ-String oder 'WGS84 UTM nnX'; dann 'X Y Z px py image [name]') in einen Passpunkt-Punktlayer und eine Beobachtungstabelle ein, die beiden Eingaben, die Passpunkte überall in TruOrtho benötigen.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="74" />
+            <source>The gcp_list.txt file.</source>
+            <translation>Die Datei gcp_list.txt.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="75" />
+            <source>Comma-separated GCP names to mark as check points (role 'check').</source>
+            <translation>Kommagetrennte Passpunktnamen, die als Kontrollpunkte markiert werden (Rolle 'check').</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="76" />
+            <source>Default planimetric standard deviation of the GCP coordinates, metres.</source>
+            <translation>Standardabweichung der Lage der Passpunktkoordinaten (Standardwert), Meter.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="77" />
+            <source>Default height standard deviation of the GCP coordinates, metres.</source>
+            <translation>Standardabweichung der Höhe der Passpunktkoordinaten (Standardwert), Meter.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="78" />
+            <source>Optional CRS to reproject the GCPs to (default: the file's CRS).</source>
+            <translation>Optionales KBS, in das die Passpunkte umprojiziert werden (Standard: das KBS der Datei).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="79" />
+            <source>GCP point layer (PointZ): name, role, z, sigma_xy, sigma_z.</source>
+            <translation>Passpunkt-Punktlayer (PointZ): name, role, z, sigma_xy, sigma_z.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="80" />
+            <source>Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the top-left pixel, as in gcp_list.txt).</source>
+            <translation>Beobachtungstabelle: gcp, image, x, y (Pixel, (0, 0) = Mitte des linken oberen Pixels, wie in gcp_list.txt).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="86" />
+            <source>Orients a block of overlapping photos: SIFT features at a working resolution, pair selection (exhaustive for small blocks, EXIF GNSS footprints, or a low-resolution retrieval pass), robust two-view geometry, tie-point tracks decimated on a grid by multiplicity, incremental reconstruction and a bundle block adjustment written for TruOrtho (collinearity equations with Brown distortion, Levenberg-Marquardt with the Schur complement, Huber loss, self-calibration). Ground control fixes the datum (7-parameter similarity, then weighted GCP observations); check points never enter the adjustment and are reported with per-axis RMSE. Without GCPs, EXIF GNSS positions serve as weighted priors; without either the block stays in an arbitrary frame.</source>
+            <translation>Orientiert einen Verband überlappender Fotos: SIFT-Merkmale in einer Arbeitsauflösung, Paarauswahl (vollständig bei kleinen Verbänden, über EXIF-GNSS-Bildabdeckungen oder einen Suchlauf in niedriger Auflösung), robuste Zweibildgeometrie, Verknüpfungspunktspuren, auf einem Raster nach Vielfachheit ausgedünnt, inkrementelle Rekonstruktion und eine für TruOrtho geschriebene Bündelblockausgleichung (Kollinearitätsgleichungen mit Brown-Verzeichnung, Levenberg-Marquardt mit dem Schur-Komplement, Huber-Verlustfunktion, Selbstkalibrierung). Passpunkte legen das Datum fest (7-Parameter-Ähnlichkeitstransformation, dann gewichtete Passpunktbeobachtungen); Kontrollpunkte gehen nie in die Ausgleichung ein und werden mit dem RMSE je Achse berichtet. Ohne Passpunkte dienen EXIF-GNSS-Positionen als gewichtete Vorinformation; ohne beides bleibt der Verband in einem beliebigen System.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="96" />
+            <source>Folder of the images (non-image files are skipped with a warning in the report).</source>
+            <translation>Ordner der Bilder (Nicht-Bilddateien werden mit einer Warnung im Bericht übersprungen).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="97" />
+            <source>The image files, instead of a folder.</source>
+            <translation>Die Bilddateien, statt eines Ordners.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="98" />
+            <source>Interior orientation: an Orthority interior file (YAML/JSON) or a text file with the 3x3 matrix K, taken as a calibration and held fixed. Without it: EXIF focal length and sensor size, else f = 1.2 x max(w, h), refined by self-calibration.</source>
+            <translation>Innere Orientierung: eine Orthority-Datei der inneren Orientierung (YAML/JSON) oder eine Textdatei mit der 3x3-Matrix K, als Kalibrierung übernommen und festgehalten. Ohne sie: EXIF-Brennweite und Sensorgröße, sonst f = 1,2 x max(w, h), verfeinert durch Selbstkalibrierung.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="101" />
+            <source>Ground control and check points: point layer with 'name', 'role' (gcp|check), PointZ or 'z', optional 'sigma_xy'/'sigma_z' (metres). Reprojected to CRS.</source>
+            <translation>Pass- und Kontrollpunkte: Punktlayer mit 'name', 'role' (gcp|check), PointZ oder 'z', optional 'sigma_xy'/'sigma_z' (Meter). Wird in CRS umprojiziert.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="103" />
+            <source>Image measurements of the GCPs: table with 'gcp', 'image' (file name), 'x', 'y' (pixels, (0, 0) = centre of the top-left pixel).</source>
+            <translation>Bildmessungen der Passpunkte: Tabelle mit 'gcp', 'image' (Dateiname), 'x', 'y' (Pixel, (0, 0) = Mitte des linken oberen Pixels).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="105" />
+            <source>CRS of the output (default: the GCP layer's, else the UTM zone of the EXIF GNSS positions).</source>
+            <translation>KBS der Ausgabe (Standard: das des Passpunktlayers, sonst die UTM-Zone der EXIF-GNSS-Positionen).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="107" />
+            <source>Larger image side at which features are detected, pixels.</source>
+            <translation>Längere Bildseite, auf der die Merkmale detektiert werden, Pixel.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="108" />
+            <source>Features kept per image.</source>
+            <translation>Pro Bild behaltene Merkmale.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="109" />
+            <source>Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment when no CAMERA file is given (else hold the prior interior orientation).</source>
+            <translation>f, cx, cy, k1, k2, p1, p2 in der Ausgleichung schätzen, wenn keine CAMERA-Datei angegeben ist (sonst die vorgegebene innere Orientierung festhalten).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="111" />
+            <source>The adjusted orientation (TruOrtho JSON).</source>
+            <translation>Die ausgeglichene Orientierung (TruOrtho-JSON).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="112" />
+            <source>HTML report (and a JSON file of the same name): sigma0, image RMS, per-image residuals, GCP and check point tables, residual vector plots, tie-point multiplicity histogram, block overview.</source>
+            <translation>HTML-Bericht (und eine gleichnamige JSON-Datei): Sigma0, Bild-RMS, Residuen je Bild, Tabellen der Pass- und Kontrollpunkte, Residuenvektor-Grafiken, Histogramm der Vielfachheit der Verknüpfungspunkte, Verbandsübersicht.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="115" />
+            <source>Projection centres (PointZ) with omega, phi, kappa.</source>
+            <translation>Projektionszentren (PointZ) mit omega, phi, kappa.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="116" />
+            <source>Tie points (PointZ) with multiplicity, mean reprojection error and colour.</source>
+            <translation>Verknüpfungspunkte (PointZ) mit Vielfachheit, mittlerem Rückprojektionsfehler und Farbe.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="117" />
+            <source>GCPs and check points with dX, dY, dZ (adjusted or triangulated minus surveyed).</source>
+            <translation>Pass- und Kontrollpunkte mit dX, dY, dZ (ausgeglichen bzw. trianguliert minus gemessen).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="123" />
+            <source>The whole chain from photos to a true orthophoto in one run: image orientation with the ground control (bundle block adjustment), dense matching in object space (OSGM), DSM filtering, a mesh, and the true orthophoto with its occlusion mask and seamlines, plus one HTML report (block overview, sigma0, GCP and check point tables, residual plot, DSM hillshade, true-orthophoto preview, time and memory per stage). The products are written to OUTPUT_FOLDER with fixed names: orientation.json, report.html, dsm.tif, pointcloud.laz, mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (and the raw DSM, confidence and orthoimage of the matching).</source>
+            <translation>Die gesamte Prozesskette von Fotos zum True Orthophoto in einem Lauf: Bildorientierung mit den Passpunkten (Bündelblockausgleichung), dichte Bildzuordnung im Objektraum (OSGM), DOM-Filterung, eine Vermaschung und das True Orthophoto mit seiner Verdeckungsmaske und den Nahtlinien, dazu ein HTML-Bericht (Verbandsübersicht, Sigma0, Tabellen der Pass- und Kontrollpunkte, Residuengrafik, DOM-Schummerung, Vorschau des True Orthophotos, Zeit und Speicher je Schritt). Die Produkte werden mit festen Namen in OUTPUT_FOLDER geschrieben: orientation.json, report.html, dsm.tif, pointcloud.laz, mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (sowie das rohe DOM, die Konfidenz und das Orthobild der Zuordnung).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="133" />
+            <source>Folder of the photos (JPEG, TIFF, PNG...); other files are skipped.</source>
+            <translation>Ordner der Fotos (JPEG, TIFF, PNG...); andere Dateien werden übersprungen.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="134" />
+            <source>Optional interior orientation (Orthority YAML/JSON or a 3x3 K text file), held fixed; otherwise EXIF priors refined by self-calibration.</source>
+            <translation>Optionale innere Orientierung (Orthority-YAML/JSON oder eine Textdatei mit der 3x3-Matrix K), festgehalten; sonst EXIF-Vorwerte, verfeinert durch Selbstkalibrierung.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="136" />
+            <source>Optional point layer of ground control and check points (fields name, role gcp|check, optional z, sigma_xy, sigma_z), as for Orient images. Needed for a georeferenced product unless the photos carry EXIF GNSS positions.</source>
+            <translation>Optionaler Punktlayer der Pass- und Kontrollpunkte (Felder name, role gcp|check, optional z, sigma_xy, sigma_z), wie bei Bilder orientieren. Für ein georeferenziertes Produkt erforderlich, sofern die Fotos keine EXIF-GNSS-Positionen enthalten.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="139" />
+            <source>Table of the GCP image measurements (gcp, image, x, y), given with GCPS.</source>
+            <translation>Tabelle der Bildmessungen der Passpunkte (gcp, image, x, y), zusammen mit GCPS anzugeben.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="140" />
+            <source>CRS of the products; default the GCP layer's CRS.</source>
+            <translation>KBS der Produkte; Standard ist das KBS des Passpunktlayers.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="141" />
+            <source>Cell size of the DSM and the true orthophoto in metres; 0 = the median ground sample distance of the near-nadir images.</source>
+            <translation>Zellgröße des DOM und des True Orthophotos in Metern; 0 = mittlere Bodenpixelgröße (Median) der nadirnahen Bilder.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="143" />
+            <source>Skip the orientation when OUTPUT_FOLDER already holds orientation.json (e.g. to rerun matching and the orthophoto with another resolution).</source>
+            <translation>Die Orientierung überspringen, wenn OUTPUT_FOLDER bereits eine orientation.json enthält (z. B. um Zuordnung und Orthophoto mit einer anderen Auflösung erneut zu rechnen).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="145" />
+            <source>Where the tiles of dense matching, DSM filtering and the true orthophoto are computed, by one executor for the three stages (a local cluster starts once); the products are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the photos and OUTPUT_FOLDER at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The orientation, the mesh and the report are computed in QGIS's process. The address is checked before the orientation starts; the scheduler is first contacted by dense matching.</source>
+            <translation>Wo die Kacheln der dichten Bildzuordnung, der DOM-Filterung und des True Orthophotos berechnet werden, durch einen Executor für alle drei Schritte (ein lokaler Cluster startet nur einmal); die Produkte sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Fotos und OUTPUT_FOLDER unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Orientierung, Dreiecksnetz und Bericht werden im Prozess von QGIS berechnet. Die Adresse wird vor dem Start der Orientierung geprüft; der Scheduler wird erstmals von der dichten Bildzuordnung kontaktiert.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="156" />
             <source>Folder of the products (created when missing; existing products are replaced).</source>
             <translation>Ordner der Produkte (wird angelegt, falls er fehlt; vorhandene Produkte werden ersetzt).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="152" />
+            <location filename="../processing/help/__init__.py" line="157" />
             <source>orientation.json: the adjusted orientation.</source>
             <translation>orientation.json: die ausgeglichene Orientierung.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="153" />
+            <location filename="../processing/help/__init__.py" line="158" />
             <source>report.html (and report.json): the quality report of the run.</source>
             <translation>report.html (und report.json): der Qualitätsbericht des Laufs.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="154" />
+            <location filename="../processing/help/__init__.py" line="159" />
             <source>dsm.tif: the filtered DSM (float32, nodata -9999).</source>
             <translation>dsm.tif: das gefilterte DOM (float32, NoData -9999).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="155" />
+            <location filename="../processing/help/__init__.py" line="160" />
             <source>pointcloud.laz: the matched points with colour and confidence.</source>
             <translation>pointcloud.laz: die zugeordneten Punkte mit Farbe und Konfidenz.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="156" />
+            <location filename="../processing/help/__init__.py" line="161" />
             <source>mesh.ply: 2.5D mesh of the filtered DSM with vertical walls and vertex colours.</source>
             <translation>mesh.ply: 2,5D-Dreiecksnetz des gefilterten DOM mit senkrechten Wänden und Eckpunktfarben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="157" />
+            <location filename="../processing/help/__init__.py" line="162" />
             <source>trueortho.tif: the true orthophoto (bands of the photos + alpha, COG).</source>
             <translation>trueortho.tif: das True Orthophoto (Kanäle der Fotos + Alpha, COG).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="158" />
+            <location filename="../processing/help/__init__.py" line="163" />
             <source>occlusion.tif: 1 where no photo sees the surface.</source>
             <translation>occlusion.tif: 1, wo kein Foto die Oberfläche sieht.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="159" />
+            <location filename="../processing/help/__init__.py" line="164" />
             <source>seamlines.gpkg: one polygon per source photo.</source>
             <translation>seamlines.gpkg: ein Polygon je Quellfoto.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="164" />
+            <location filename="../processing/help/__init__.py" line="169" />
             <source>Dense image matching in object space (OSGM): computes a DSM directly on a ground grid from the oriented images, without rectification or pairwise depth maps. For every tile of the grid the images that see it (at most MAX_IMAGES) are resampled onto the horizontal plane of every search height (voxels of RESOLUTION x RESOLUTION x Z_STEP); a matching cost from all of them per cell and height is aggregated by semi-global matching along 8 or 16 paths (penalty P1 for a change of one height step, P2 for larger jumps, lowered across image edges), and each cell takes the height of least aggregated cost, refined between steps, with a confidence in [0, 1]. Matching runs coarse to fine over an image pyramid, by tiles, with progress and cancel. Cells without a reliable match are nodata (filter and fill them with truortho:dsmfilter). Optionally writes the confidence, an orthoimage coloured from the matched images, and a point cloud; with OBLIQUE = auto, groups of oblique images are matched in extra reference systems along their viewing directions, whose points (facades) go to the point cloud.</source>
             <translation>Dichte Bildzuordnung im Objektraum (OSGM): berechnet ein DOM direkt auf einem Bodenraster aus den orientierten Bildern, ohne Epipolarentzerrung oder paarweise Tiefenkarten. Für jede Kachel des Rasters werden die Bilder, die sie sehen (höchstens MAX_IMAGES), auf die horizontale Ebene jeder Suchhöhe umgebildet (Voxel von RESOLUTION x RESOLUTION x Z_STEP); ein Zuordnungskostenwert aus allen diesen Bildern je Zelle und Höhe wird durch Semi-Global Matching entlang 8 oder 16 Pfaden aggregiert (Strafterm P1 für eine Änderung um einen Höhenschritt, P2 für größere Sprünge, an Bildkanten verringert), und jede Zelle erhält die Höhe mit den geringsten aggregierten Kosten, zwischen den Schritten verfeinert, mit einer Konfidenz in [0, 1]. Die Zuordnung läuft grob-zu-fein über eine Bildpyramide, kachelweise, mit Fortschrittsanzeige und Abbruchmöglichkeit. Zellen ohne zuverlässige Zuordnung sind NoData (mit truortho:dsmfilter filtern und füllen). Optional werden die Konfidenz, ein aus den zugeordneten Bildern eingefärbtes Orthobild und eine Punktwolke geschrieben; mit OBLIQUE = auto werden Gruppen von Schrägbildern in zusätzlichen Referenzsystemen entlang ihrer Blickrichtungen zugeordnet, deren Punkte (Fassaden) in die Punktwolke gehen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="178" />
+            <location filename="../processing/help/__init__.py" line="183" />
             <source>Orientation JSON (from Orient images or Import orientation) with a projected CRS (metres) and at least two images, which must be on disk.</source>
             <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren) mit einem projizierten KBS (Meter) und mindestens zwei Bildern, die auf der Festplatte vorhanden sein müssen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="180" />
+            <location filename="../processing/help/__init__.py" line="185" />
             <source>Area to match (reprojected to the orientation's CRS); default the extent of the sparse points (1-99 %), else the union of the near-nadir image footprints. It must intersect the area the images see.</source>
             <translation>Zuzuordnender Bereich (in das KBS der Orientierung umprojiziert); Standard ist die Ausdehnung der dünnen Punktwolke (1-99 %), sonst die Vereinigung der Bildabdeckungen der nadirnahen Bilder. Er muss den von den Bildern gesehenen Bereich schneiden.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="183" />
+            <location filename="../processing/help/__init__.py" line="188" />
             <source>Cell size of the DSM, metres; empty or 0 = the median ground sample distance of the near-nadir images.</source>
             <translation>Zellgröße des DOM, Meter; leer oder 0 = mittlere Bodenpixelgröße (Median) der nadirnahen Bilder.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="185" />
+            <location filename="../processing/help/__init__.py" line="190" />
             <source>Height step between two search planes, metres; empty or 0 = the resolution.</source>
             <translation>Höhenschritt zwischen zwei Suchebenen, Meter; leer oder 0 = die Auflösung.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="186" />
+            <location filename="../processing/help/__init__.py" line="191" />
             <source>Lowest height searched (world Z, the orientation's vertical datum); empty = from the sparse points (0.5 % percentile minus a margin), else from the GCP heights. Must be below Z_MAX.</source>
             <translation>Niedrigste gesuchte Höhe (Welt-Z, das Höhendatum der Orientierung); leer = aus der dünnen Punktwolke (0,5-%-Perzentil minus einem Rand), sonst aus den Passpunkthöhen. Muss unter Z_MAX liegen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="189" />
+            <location filename="../processing/help/__init__.py" line="194" />
             <source>Highest height searched; empty = from the sparse points (99.5 % percentile plus a margin), else half the flying height above the highest GCP. Always kept below the cameras. Without sparse points or GCPs give Z_MIN and Z_MAX.</source>
             <translation>Höchste gesuchte Höhe; leer = aus der dünnen Punktwolke (99,5-%-Perzentil plus einem Rand), sonst die halbe Flughöhe über dem höchsten Passpunkt. Bleibt immer unterhalb der Kameras. Ohne dünne Punktwolke oder Passpunkte Z_MIN und Z_MAX angeben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="192" />
+            <location filename="../processing/help/__init__.py" line="197" />
             <source>Optional coarse DSM or DTM raster: the search at each cell is bounded by the lowest and highest height of its neighbourhood plus a margin, which speeds up matching and avoids wrong heights on rough terrain.</source>
             <translation>Optionales grobes DOM- oder DGM-Raster: die Suche an jeder Zelle wird durch die niedrigste und höchste Höhe ihrer Nachbarschaft plus einen Rand begrenzt, was die Zuordnung beschleunigt und falsche Höhen in rauem Gelände vermeidet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="195" />
+            <location filename="../processing/help/__init__.py" line="200" />
             <source>Number of aggregation directions of semi-global matching: 8 (faster) or 16 (smoother slanted surfaces).</source>
             <translation>Anzahl der Aggregationsrichtungen des Semi-Global Matching: 8 (schneller) oder 16 (glattere geneigte Flächen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="197" />
+            <location filename="../processing/help/__init__.py" line="202" />
             <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
             <translation>none: ein Nadir-Referenzsystem (das DOM). auto: Gruppen von Schrägbildern erhalten zusätzlich Referenzsysteme entlang ihrer Blickrichtungen, deren Punkte mit ihrer 'system'-Kennung in die Punktwolke gehen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="200" />
+            <location filename="../processing/help/__init__.py" line="205" />
             <source>Penalty for a change of one height step between neighbouring cells, in cost units (unrelated image windows cost 1023); empty = 256.</source>
             <translation>Strafterm für eine Änderung um einen Höhenschritt zwischen benachbarten Zellen, in Kosteneinheiten (unabhängige Bildfenster kosten 1023); leer = 256.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="202" />
+            <location filename="../processing/help/__init__.py" line="207" />
             <source>Penalty for a larger height jump, above P1 and at most 3072; empty = 2048 (a jump then needs contrary evidence from two cells).</source>
             <translation>Strafterm für einen größeren Höhensprung, über P1 und höchstens 3072; leer = 2048 (ein Sprung erfordert dann Gegenevidenz aus zwei Zellen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="204" />
+            <location filename="../processing/help/__init__.py" line="209" />
             <source>Largest number of images matched per tile (best coverage first, then the most nadir); memory and time grow with it.</source>
             <translation>Größte Anzahl pro Kachel zugeordneter Bilder (beste Abdeckung zuerst, dann die nadirnächsten); Speicherbedarf und Rechenzeit wachsen damit.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="206" />
+            <location filename="../processing/help/__init__.py" line="211" />
             <source>Tile side in cells; memory grows with its square, the number of search heights and MAX_IMAGES.</source>
             <translation>Kachelseite in Zellen; der Speicherbedarf wächst mit ihrem Quadrat, der Anzahl der Suchhöhen und MAX_IMAGES.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="208" />
+            <location filename="../processing/help/__init__.py" line="213" />
             <source>Where the tiles are matched; the DSM and confidence are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with the same inputs and parameters after a crash reuses them.</source>
             <translation>Wo die Kacheln zugeordnet werden; DOM und Konfidenz sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Fertige Kacheln werden bis zum Ende des Laufs neben dem DOM aufbewahrt (DSM.tif.tiles), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
         </message>
@@ -1374,277 +1374,277 @@
             <translation>Wo die Kacheln des Mosaiks berechnet werden; True Orthophoto, Quellbildindex, Verdeckungsmaske und Nahtlinien sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder und die Oberfläche unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Der Farbausgleich (auf einem ausgedünnten Raster) wird im Prozess von QGIS geschätzt. Fertige Kacheln werden bis zum erfolgreichen Ende des Laufs in einem Ordner neben der Ausgabe aufbewahrt (ihr Name plus '.tiles'), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="279" />
+            <location filename="../processing/help/__init__.py" line="274" />
             <source>GeoTIFF with the images' bands and data type plus an alpha band, tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
             <translation>GeoTIFF mit den Kanälen und dem Datentyp der Bilder plus einem Alphakanal, gekachelt, mit Übersichten, im Cloud-Optimized-GeoTIFF-Layout.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="281" />
+            <location filename="../processing/help/__init__.py" line="276" />
             <source>Int16 GeoTIFF: index (0-based, orientation order) of the image each cell comes from; -1 = nodata.</source>
             <translation>Int16-GeoTIFF: Index (ab 0, Reihenfolge der Orientierung) des Bildes, aus dem jede Zelle stammt; -1 = NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="283" />
+            <location filename="../processing/help/__init__.py" line="278" />
             <source>UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the surface has no data.</source>
             <translation>UInt8-GeoTIFF: 1, wo kein Bild die Zelle sieht, 0, wo sie gesehen wird, 255, wo die Oberfläche keine Daten hat.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="285" />
+            <location filename="../processing/help/__init__.py" line="280" />
             <source>Polygons, one feature per source image: the cells it colours (image_index, image, cells, area).</source>
             <translation>Polygone, ein Objekt pro Quellbild: die Zellen, die es einfärbt (image_index, image, cells, area).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="291" />
+            <location filename="../processing/help/__init__.py" line="286" />
             <source>Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the cells of blurred height steps to the nearer side, removes outliers (cells that depart from the confidence-weighted median of their window by more than the threshold and have too few neighbours at their height, so roof edges and corners survive), fills holes up to a maximum width by harmonic interpolation (holes at the foot of walls from the ground side only; wider holes stay nodata and are reported), and optionally smooths planar surfaces without blurring their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the statistics (removed outliers, filled cells, remaining holes) are returned and logged.</source>
             <translation>Bereinigt ein rohes DOM (z. B. das DOM der dichten Bildzuordnung aus dem OSGM-Schritt von TruOrtho) kachelweise: schiebt die Zellen verschliffener Höhensprünge auf die nähere Seite, entfernt Ausreißer (Zellen, die um mehr als die Schwelle vom konfidenzgewichteten Median ihres Fensters abweichen und zu wenige Nachbarn auf ihrer Höhe haben, sodass Dachkanten und Ecken erhalten bleiben), füllt Lücken bis zu einer Höchstbreite durch harmonische Interpolation (Lücken am Fuß von Wänden nur von der Bodenseite aus; breitere Lücken bleiben NoData und werden gemeldet) und glättet optional ebene Flächen, ohne ihre Kanten zu verwischen. Optional wird ein Geländemodell (DGM) durch Bodenfilterung nach Art von SMRF abgeleitet sowie das normalisierte DOM (Höhe über Gelände). Die Ausgaben behalten KBS, Raster und NoData der Eingabe; die Statistik (entfernte Ausreißer, gefüllte Zellen, verbleibende Lücken) wird zurückgegeben und protokolliert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="302" />
+            <location filename="../processing/help/__init__.py" line="297" />
             <source>Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.</source>
             <translation>Rohes DOM: einkanaliges Raster mit einem projizierten KBS (Meter); seine NoData-Zellen sind Lücken.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="303" />
+            <location filename="../processing/help/__init__.py" line="298" />
             <source>Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum confidence are removed, less confident cells must agree better with their neighbours, and the median is weighted by confidence.</source>
             <translation>Optionales Konfidenzraster in [0, 1] (CONFIDENCE von OSGM): Zellen unter der Mindestkonfidenz werden entfernt, weniger zuverlässige Zellen müssen besser mit ihren Nachbarn übereinstimmen, und der Median wird mit der Konfidenz gewichtet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="306" />
+            <location filename="../processing/help/__init__.py" line="301" />
             <source>Largest departure from the neighbourhood median, metres (empty: 4 x the resolution).</source>
             <translation>Größte Abweichung vom Median der Nachbarschaft, Meter (leer: 4 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="308" />
+            <location filename="../processing/help/__init__.py" line="303" />
             <source>Side of the median window in cells (odd); a second pass uses twice the window.</source>
             <translation>Seitenlänge des Medianfensters in Zellen (ungerade); ein zweiter Durchlauf verwendet das doppelte Fenster.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="310" />
+            <location filename="../processing/help/__init__.py" line="305" />
             <source>Neighbours within the threshold of a cell's height that keep it although it departs from the median (edges, corners, thin structures).</source>
             <translation>Nachbarn innerhalb der Schwelle um die Höhe einer Zelle, die sie erhalten, obwohl sie vom Median abweicht (Kanten, Ecken, dünne Strukturen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="312" />
+            <location filename="../processing/help/__init__.py" line="307" />
             <source>With a confidence raster: cells below this confidence are removed.</source>
             <translation>Mit einem Konfidenzraster: Zellen unter dieser Konfidenz werden entfernt.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="313" />
+            <location filename="../processing/help/__init__.py" line="308" />
             <source>With a confidence raster: less confident cells are removed when they depart by more than the threshold from the median of the cells at least this confident in their 15 x 15 window (0: off).</source>
             <translation>Mit einem Konfidenzraster: weniger zuverlässige Zellen werden entfernt, wenn sie um mehr als die Schwelle vom Median der Zellen mit mindestens dieser Konfidenz in ihrem 15-x-15-Fenster abweichen (0: aus).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="316" />
+            <location filename="../processing/help/__init__.py" line="311" />
             <source>Largest hole width (metres) that is interpolated; 0 fills nothing.</source>
             <translation>Größte Lückenbreite (Meter), die interpoliert wird; 0 füllt nichts.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="317" />
+            <location filename="../processing/help/__init__.py" line="312" />
             <source>Height difference between two surfaces (a wall), metres: hole boundary cells that much above nearby boundary cells are not interpolated from.</source>
             <translation>Höhenunterschied zwischen zwei Oberflächen (eine Wand), Meter: Randzellen einer Lücke, die so viel höher als benachbarte Randzellen liegen, werden nicht zur Interpolation verwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="319" />
+            <location filename="../processing/help/__init__.py" line="314" />
             <source>Snap the cells of blurred height steps (between the two levels of their 5 x 5 window) to the nearer level.</source>
             <translation>Die Zellen verschliffener Höhensprünge (zwischen den beiden Niveaus ihres 5-x-5-Fensters) auf das nähere Niveau schieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="321" />
+            <location filename="../processing/help/__init__.py" line="316" />
             <source>Replace cells by a local plane fitted to the neighbours at their height (flat and pitched roofs, streets); steps stay sharp.</source>
             <translation>Zellen durch eine lokale Ebene ersetzen, die an die Nachbarn auf ihrer Höhe angepasst ist (Flach- und Schrägdächer, Straßen); Sprünge bleiben scharf.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="323" />
+            <location filename="../processing/help/__init__.py" line="318" />
             <source>Radius of the smoothing neighbourhood, cells.</source>
             <translation>Radius der Glättungsnachbarschaft, Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="324" />
+            <location filename="../processing/help/__init__.py" line="319" />
             <source>Neighbours within this height of a cell belong to its surface, metres (empty: 2.5 x the resolution).</source>
             <translation>Nachbarn innerhalb dieser Höhe um eine Zelle gehören zu ihrer Oberfläche, Meter (leer: 2,5 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="326" />
+            <location filename="../processing/help/__init__.py" line="321" />
             <source>Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); the DTM is written on the DSM grid.</source>
             <translation>Zellgröße des Bodenfilters, Meter (leer: max(1 m, DOM-Auflösung)); das DGM wird auf dem DOM-Raster geschrieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="328" />
+            <location filename="../processing/help/__init__.py" line="323" />
             <source>Largest opening radius of the ground filter, metres: more than half the width of the largest building.</source>
             <translation>Größter Öffnungsradius des Bodenfilters, Meter: mehr als die halbe Breite des größten Gebäudes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="330" />
+            <location filename="../processing/help/__init__.py" line="325" />
             <source>Terrain slope (rise over run) the ground filter keeps as ground.</source>
             <translation>Geländeneigung (Höhe pro Strecke), die der Bodenfilter als Boden behält.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="331" />
+            <location filename="../processing/help/__init__.py" line="326" />
             <source>Where the tiles are filtered; the filtered DSM and the statistics are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The terrain model is computed in QGIS's process.</source>
             <translation>Wo die Kacheln gefiltert werden; gefiltertes DOM und Statistik sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen das DOM und das Konfidenzraster unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Das Geländemodell wird im Prozess von QGIS berechnet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="344" />
+            <location filename="../processing/help/__init__.py" line="334" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>Gefiltertes DOM (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="345" />
+            <location filename="../processing/help/__init__.py" line="335" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Optionales Geländemodell (GeoTIFF, float32, DOM-Raster).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="346" />
+            <location filename="../processing/help/__init__.py" line="336" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>Optionales normalisiertes DOM: DOM minus DGM, Höhen über dem Gelände.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="347" />
+            <location filename="../processing/help/__init__.py" line="337" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON: die Filterstatistik (und die des Bodenfilters).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="348" />
+            <location filename="../processing/help/__init__.py" line="338" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Als Ausreißer oder wegen geringer Konfidenz entfernte Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="349" />
+            <location filename="../processing/help/__init__.py" line="339" />
             <source>Hole cells interpolated.</source>
             <translation>Interpolierte Lückenzellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="350" />
+            <location filename="../processing/help/__init__.py" line="340" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Lücken, breiter als MAX_HOLE, als NoData belassen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="355" />
+            <location filename="../processing/help/__init__.py" line="345" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Erzeugt eine Dreiecksvermaschung. Aus einem DOM: ein 2,5D-Netz, dessen Höhensprünge senkrechte Wände sind (kein Dreieck überspannt je einen Sprung) und dessen ebene und glatte Bereiche durch einen eingeschränkten Quadtree mit garantierter Höhenfehlerschranke an jedem Zellmittelpunkt ausgedünnt werden; Eckpunktfarben aus einem optionalen Orthobild. Aus einer Punktwolke (LAS/LAZ oder EPT, z. B. zusammengeführte Zuordnung von Schrägbildern): ein 2,5D-Delaunay-Netz je Referenzsystem, entlang seiner Blickrichtung gesehen (überlappende Schichten, wo Systeme dieselbe Oberfläche sehen; nicht wasserdicht). Schreibt PLY (binär) oder OBJ, im KBS oder in einem lokalen System, dessen Offset im Dateikopf vermerkt ist; truortho:trueortho liest es als SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="364" />
+            <location filename="../processing/help/__init__.py" line="354" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>DOM-Raster (projiziertes KBS) oder Punktwolke (.las, .laz oder eine EPT-ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="365" />
+            <location filename="../processing/help/__init__.py" line="355" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Optionales Orthobild (RGB) für die Eckpunktfarben eines DOM-Netzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="366" />
+            <location filename="../processing/help/__init__.py" line="356" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Größter Höhenunterschied zwischen Netz und DOM an einem Zellmittelpunkt, Meter (leer: halbe DOM-Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="368" />
+            <location filename="../processing/help/__init__.py" line="358" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Kleinster Höhenunterschied zwischen benachbarten Zellen, der zur Wand wird, Meter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="369" />
+            <location filename="../processing/help/__init__.py" line="359" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Steilste als geneigte Dreiecke erhaltene Neigung, Grad: die Sprungschwelle ist max(MIN_STEP, Auflösung x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="371" />
+            <location filename="../processing/help/__init__.py" line="361" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Größter Zellblock, den ein Dreieckspaar abdecken darf (eine Zweierpotenz).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="372" />
+            <location filename="../processing/help/__init__.py" line="362" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Punktwolken: längste Dreieckskante, Meter (leer: 4 x der mittlere Punktabstand).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="373" />
+            <location filename="../processing/help/__init__.py" line="363" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>CRS: Weltkoordinaten (PLY-Doubles). Lokal: Welt minus einem Offset, vermerkt als 'comment offset E N H' (PLY) oder '# offset E N H' (OBJ), für Viewer, die kleine Zahlen benötigen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="375" />
+            <location filename="../processing/help/__init__.py" line="365" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Das Netz: .ply (binär, Little-Endian, 'comment crs ...') oder .obj ('# crs ...', Eckpunktfarben als 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="377" />
+            <location filename="../processing/help/__init__.py" line="367" />
             <source>Number of vertices.</source>
             <translation>Anzahl der Eckpunkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="378" />
+            <location filename="../processing/help/__init__.py" line="368" />
             <source>Number of triangles.</source>
             <translation>Anzahl der Dreiecke.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="379" />
+            <location filename="../processing/help/__init__.py" line="369" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Anzahl der senkrechten Wanddreiecke (DOM-Netze).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="384" />
+            <location filename="../processing/help/__init__.py" line="374" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (Layer &gt; Add Layer &gt; Point Cloud, choose ept.json).</source>
             <translation>Exportiert ein DOM als Punktwolke, ein Punkt je gültigem Zellmittelpunkt, mit Farben aus einem Orthobild und Konfidenz je Punkt aus einem Konfidenzraster: LAS 1.4 oder LAZ (Punktformat 7, KBS als WKT, Zusatzdimensionen 'confidence' und 'system' (das Referenzsystem), ein TruOrtho-VLR, der die Referenzsysteme beschreibt), lesbar mit PDAL, laspy, LAStools und CloudCompare. Daneben wird ein Entwine-Point-Tile-Datensatz (EPT) geschrieben: QGIS-Builds ohne PDAL (wie das QGIS 3.22 von Debian) öffnen ihn als Punktwolken-Layer (Layer &gt; Layer hinzufügen &gt; Punktwolke, ept.json wählen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="392" />
+            <location filename="../processing/help/__init__.py" line="382" />
             <source>DSM raster with a projected CRS.</source>
             <translation>DOM-Raster mit einem projizierten KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="393" />
+            <location filename="../processing/help/__init__.py" line="383" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Optionales Orthobild (RGB) für die Punktfarben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="394" />
+            <location filename="../processing/help/__init__.py" line="384" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Optionales Konfidenzraster in [0, 1], gespeichert als Dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="395" />
+            <location filename="../processing/help/__init__.py" line="385" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Die Punktwolke (.laz komprimiert oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="396" />
+            <location filename="../processing/help/__init__.py" line="386" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Ordner des EPT-Datensatzes (ept.json, ept-data/, ept-hierarchy/); leer lassen, um ihn zu überspringen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="397" />
+            <location filename="../processing/help/__init__.py" line="387" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Pfad der ept.json des EPT-Datensatzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="398" />
+            <location filename="../processing/help/__init__.py" line="388" />
             <source>Number of points written.</source>
             <translation>Anzahl der geschriebenen Punkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="403" />
+            <location filename="../processing/help/__init__.py" line="393" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Führt Punktwolken mehrerer Referenzsysteme (z. B. das Nadir- und die Schrägsysteme der dichten Bildzuordnung) in einer LAS-1.4-/LAZ-Datei zusammen und behält dabei 'system' jedes Punktes (Dateien ohne dieses Attribut erhalten den Index ihrer Datei) und seine Konfidenz; dünnt optional Duplikate auf einem Voxelgitter aus und behält den zuverlässigsten Punkt jedes Voxels; schreibt optional einen EPT-Datensatz für QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="409" />
+            <location filename="../processing/help/__init__.py" line="399" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>LAS/LAZ-Dateien in einem KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="410" />
+            <location filename="../processing/help/__init__.py" line="400" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Voxelgröße für das Ausdünnen, Meter (leer: jeden Punkt behalten).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="411" />
+            <location filename="../processing/help/__init__.py" line="401" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Die zusammengeführte Punktwolke (.laz oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="412" />
+            <location filename="../processing/help/__init__.py" line="402" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Optionaler Ordner für einen EPT-Datensatz der zusammengeführten Wolke.</translation>
         </message>

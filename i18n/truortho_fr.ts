@@ -4,192 +4,192 @@
     <context>
         <name>TruOrtho</name>
         <message>
-            <location filename="../processing/algorithms/base.py" line="10" />
+            <location filename="../processing/algorithms/base.py" line="16" />
             <source>Orientation</source>
             <translation>Orientation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="10" />
+            <location filename="../processing/algorithms/base.py" line="16" />
             <source>Orthophoto</source>
             <translation>Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="10" />
+            <location filename="../processing/algorithms/base.py" line="16" />
             <source>Surface</source>
             <translation>Surface</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="10" />
+            <location filename="../processing/algorithms/base.py" line="16" />
             <source>Tools</source>
             <translation>Outils</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="57" />
-            <source>Ground control points</source>
-            <translation>Points d'appui</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/base.py" line="63" />
-            <source>GCP image measurements (table)</source>
-            <translation>Mesures image des points d'appui (table)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="34" />
-            <source>Filter DSM (outliers, holes, smoothing, DTM)</source>
-            <translation>Filtrer le MNS (valeurs aberrantes, trous, lissage, MNT)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="284" />
-            <source>Filtered DSM</source>
-            <translation>MNS filtré</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="67" />
-            <source>Raw DSM</source>
-            <translation>MNS brut</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="69" />
-            <source>Confidence raster [0, 1]</source>
-            <translation>Raster de confiance [0, 1]</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="74" />
-            <source>Outlier threshold (m; empty = 4 x resolution)</source>
-            <translation>Seuil des valeurs aberrantes (m ; vide = 4 x la résolution)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="81" />
-            <source>Largest hole width filled (m)</source>
-            <translation>Largeur maximale des trous comblés (m)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="82" />
-            <source>Sharpen blurred height steps</source>
-            <translation>Rendre nets les sauts de hauteur flous</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="85" />
-            <source>Edge-preserving smoothing of planar surfaces</source>
-            <translation>Lissage des surfaces planes préservant les arêtes</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="91" />
-            <source>Outlier window (cells, odd)</source>
-            <translation>Fenêtre des valeurs aberrantes (cellules, impair)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="100" />
-            <source>Supporting neighbours that keep a cell</source>
-            <translation>Voisins d'appui qui conservent une cellule</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="104" />
-            <source>Minimum confidence</source>
-            <translation>Confiance minimale</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="110" />
-            <source>Confident cells (confidence at least)</source>
-            <translation>Cellules fiables (confiance au moins)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="119" />
-            <source>Height step between surfaces (m)</source>
-            <translation>Saut de hauteur entre surfaces (m)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="123" />
-            <source>Smoothing radius (cells)</source>
-            <translation>Rayon de lissage (cellules)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="129" />
-            <source>Smoothing height tolerance (m; empty = 2.5 x resolution)</source>
-            <translation>Tolérance en hauteur du lissage (m ; vide = 2,5 x la résolution)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="140" />
-            <source>Ground filter cell size (m; empty = max(1 m, resolution))</source>
-            <translation>Taille de cellule du filtre de sol (m ; vide = max(1 m, résolution))</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="149" />
-            <source>Ground filter window radius (m)</source>
-            <translation>Rayon de fenêtre du filtre de sol (m)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="153" />
-            <source>Ground filter slope (rise/run)</source>
-            <translation>Pente du filtre de sol (dénivelé/distance)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="159" />
+            <location filename="../processing/algorithms/base.py" line="71" />
             <source>Run tiles on</source>
             <translation>Exécuter les tuiles sur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="174" />
+            <location filename="../processing/algorithms/base.py" line="84" />
             <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
             <translation>Adresse du planificateur Dask (tls://hôte:port ou fichier de planificateur ; vide = TRUORTHO_DASK_SCHEDULER)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="186" />
-            <source>Terrain model (DTM)</source>
-            <translation>Modèle numérique de terrain (MNT)</translation>
+            <location filename="../processing/algorithms/base.py" line="104" />
+            <source>Ground control points</source>
+            <translation>Points d'appui</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="191" />
-            <source>Normalised DSM (height above terrain)</source>
-            <translation>MNS normalisé (hauteur au-dessus du terrain)</translation>
+            <location filename="../processing/algorithms/base.py" line="110" />
+            <source>GCP image measurements (table)</source>
+            <translation>Mesures image des points d'appui (table)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="194" />
-            <source>Statistics (JSON)</source>
-            <translation>Statistiques (JSON)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="195" />
-            <source>Outliers removed (cells)</source>
-            <translation>Valeurs aberrantes supprimées (cellules)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="196" />
-            <source>Hole cells filled</source>
-            <translation>Cellules de trous comblées</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="197" />
-            <source>Holes left as nodata</source>
-            <translation>Trous laissés en NoData</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="286" />
-            <source>DTM</source>
-            <translation>MNT</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="161" />
+            <location filename="../processing/algorithms/base.py" line="73" />
             <source>inprocess: this process (all cores)</source>
             <translation>inprocess : ce processus (tous les cœurs)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <location filename="../processing/algorithms/base.py" line="74" />
             <source>local: a Dask cluster of worker processes on this computer</source>
             <translation>local : une grappe Dask de processus de travail sur cet ordinateur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="163" />
+            <location filename="../processing/algorithms/base.py" line="75" />
             <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
             <translation>scheduler : un planificateur Dask (SCHEDULER_ADDRESS)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="246" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="32" />
+            <source>Filter DSM (outliers, holes, smoothing, DTM)</source>
+            <translation>Filtrer le MNS (valeurs aberrantes, trous, lissage, MNT)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="255" />
+            <source>Filtered DSM</source>
+            <translation>MNS filtré</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="64" />
+            <source>Raw DSM</source>
+            <translation>MNS brut</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="66" />
+            <source>Confidence raster [0, 1]</source>
+            <translation>Raster de confiance [0, 1]</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="71" />
+            <source>Outlier threshold (m; empty = 4 x resolution)</source>
+            <translation>Seuil des valeurs aberrantes (m ; vide = 4 x la résolution)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="78" />
+            <source>Largest hole width filled (m)</source>
+            <translation>Largeur maximale des trous comblés (m)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="79" />
+            <source>Sharpen blurred height steps</source>
+            <translation>Rendre nets les sauts de hauteur flous</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="82" />
+            <source>Edge-preserving smoothing of planar surfaces</source>
+            <translation>Lissage des surfaces planes préservant les arêtes</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="88" />
+            <source>Outlier window (cells, odd)</source>
+            <translation>Fenêtre des valeurs aberrantes (cellules, impair)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="97" />
+            <source>Supporting neighbours that keep a cell</source>
+            <translation>Voisins d'appui qui conservent une cellule</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="101" />
+            <source>Minimum confidence</source>
+            <translation>Confiance minimale</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="107" />
+            <source>Confident cells (confidence at least)</source>
+            <translation>Cellules fiables (confiance au moins)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="116" />
+            <source>Height step between surfaces (m)</source>
+            <translation>Saut de hauteur entre surfaces (m)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="120" />
+            <source>Smoothing radius (cells)</source>
+            <translation>Rayon de lissage (cellules)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="126" />
+            <source>Smoothing height tolerance (m; empty = 2.5 x resolution)</source>
+            <translation>Tolérance en hauteur du lissage (m ; vide = 2,5 x la résolution)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="137" />
+            <source>Ground filter cell size (m; empty = max(1 m, resolution))</source>
+            <translation>Taille de cellule du filtre de sol (m ; vide = max(1 m, résolution))</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="146" />
+            <source>Ground filter window radius (m)</source>
+            <translation>Rayon de fenêtre du filtre de sol (m)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="150" />
+            <source>Ground filter slope (rise/run)</source>
+            <translation>Pente du filtre de sol (dénivelé/distance)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="157" />
+            <source>Terrain model (DTM)</source>
+            <translation>Modèle numérique de terrain (MNT)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <source>Normalised DSM (height above terrain)</source>
+            <translation>MNS normalisé (hauteur au-dessus du terrain)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="165" />
+            <source>Statistics (JSON)</source>
+            <translation>Statistiques (JSON)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="166" />
+            <source>Outliers removed (cells)</source>
+            <translation>Valeurs aberrantes supprimées (cellules)</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="167" />
+            <source>Hole cells filled</source>
+            <translation>Cellules de trous comblées</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="168" />
+            <source>Holes left as nodata</source>
+            <translation>Trous laissés en NoData</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="257" />
+            <source>DTM</source>
+            <translation>MNT</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/dsmfilter.py" line="217" />
             <source>{} holes ({} cells, widest {:.1f} m) are wider than {} m and stay nodata</source>
             <translation>{} trous ({} cellules, le plus large {:.1f} m) dépassent {} m et restent en NoData</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="274" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="245" />
             <source>Ground filter at {:.2f} m: {:.1f} % of the cells are ground</source>
             <translation>Filtre de sol à {:.2f} m : {:.1f} % des cellules sont du sol</translation>
         </message>
@@ -584,217 +584,217 @@
             <translation>IMAGES : {} n'est pas un dossier</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="39" />
+            <location filename="../processing/algorithms/osgm.py" line="38" />
             <source>Dense matching (OSGM)</source>
             <translation>Appariement dense (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="308" />
+            <location filename="../processing/algorithms/osgm.py" line="280" />
             <source>DSM (OSGM)</source>
             <translation>MNS (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="74" />
+            <location filename="../processing/algorithms/osgm.py" line="72" />
             <source>Extent (default: the area seen by the images)</source>
             <translation>Emprise (par défaut : la zone vue par les images)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="80" />
+            <location filename="../processing/algorithms/osgm.py" line="78" />
             <source>Resolution (m; empty or 0 = median ground sample distance)</source>
             <translation>Résolution (m ; vide ou 0 = taille médiane du pixel au sol)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="90" />
+            <location filename="../processing/algorithms/osgm.py" line="88" />
             <source>Height step of the search (m; empty or 0 = the resolution)</source>
             <translation>Pas de hauteur de la recherche (m ; vide ou 0 = la résolution)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="100" />
+            <location filename="../processing/algorithms/osgm.py" line="98" />
             <source>Lowest height searched (m; empty = automatic)</source>
             <translation>Hauteur minimale recherchée (m ; vide = automatique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="109" />
+            <location filename="../processing/algorithms/osgm.py" line="107" />
             <source>Highest height searched (m; empty = automatic)</source>
             <translation>Hauteur maximale recherchée (m ; vide = automatique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="117" />
+            <location filename="../processing/algorithms/osgm.py" line="115" />
             <source>Coarse surface bounding the search per cell (DSM/DTM)</source>
             <translation>Surface grossière bornant la recherche par cellule (MNS/MNT)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="123" />
+            <location filename="../processing/algorithms/osgm.py" line="121" />
             <source>Aggregation paths</source>
             <translation>Chemins d'agrégation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="131" />
+            <location filename="../processing/algorithms/osgm.py" line="129" />
             <source>Oblique images</source>
             <translation>Images obliques</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="139" />
+            <location filename="../processing/algorithms/osgm.py" line="137" />
             <source>Penalty P1, one height step (cost units; empty = default)</source>
             <translation>Pénalité P1, un pas de hauteur (unités de coût ; vide = par défaut)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="150" />
+            <location filename="../processing/algorithms/osgm.py" line="148" />
             <source>Penalty P2, larger height jumps (cost units; empty = default)</source>
             <translation>Pénalité P2, sauts de hauteur plus grands (unités de coût ; vide = par défaut)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="159" />
+            <location filename="../processing/algorithms/osgm.py" line="157" />
             <source>Images per tile (at most)</source>
             <translation>Images par tuile (au plus)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="163" />
+            <location filename="../processing/algorithms/osgm.py" line="161" />
             <source>Tile size (cells)</source>
             <translation>Taille des tuiles (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="196" />
+            <location filename="../processing/algorithms/osgm.py" line="168" />
             <source>Confidence [0, 1]</source>
             <translation>Confiance [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="201" />
+            <location filename="../processing/algorithms/osgm.py" line="173" />
             <source>Orthoimage (matching colours)</source>
             <translation>Orthoimage (couleurs de l'appariement)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="207" />
+            <location filename="../processing/algorithms/osgm.py" line="179" />
             <source>Point cloud</source>
             <translation>Nuage de points</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="232" />
+            <location filename="../processing/algorithms/osgm.py" line="204" />
             <source>EXTENT: the extent is empty</source>
             <translation>EXTENT : l'emprise est vide</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="311" />
+            <location filename="../processing/algorithms/osgm.py" line="283" />
             <source>Confidence (OSGM)</source>
             <translation>Confiance (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="314" />
+            <location filename="../processing/algorithms/osgm.py" line="286" />
             <source>Orthoimage (OSGM)</source>
             <translation>Orthoimage (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="132" />
+            <location filename="../processing/algorithms/osgm.py" line="130" />
             <source>none: one nadir reference system</source>
             <translation>none : un seul système de référence au nadir</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="132" />
+            <location filename="../processing/algorithms/osgm.py" line="130" />
             <source>auto: extra systems for obliques</source>
             <translation>auto : systèmes supplémentaires pour les obliques</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="245" />
+            <location filename="../processing/algorithms/osgm.py" line="217" />
             <source>ORIENTATION: the file {!r} does not exist</source>
             <translation>ORIENTATION : le fichier {!r} n'existe pas</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="257" />
+            <location filename="../processing/algorithms/osgm.py" line="229" />
             <source>Z_MIN ({}) must be below Z_MAX ({})</source>
             <translation>Z_MIN ({}) doit être inférieur à Z_MAX ({})</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="273" />
+            <location filename="../processing/algorithms/osgm.py" line="245" />
             <source>POINT_CLOUD: expected a .las or .laz file, got {!r}</source>
             <translation>POINT_CLOUD : fichier .las ou .laz attendu, reçu {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="252" />
+            <location filename="../processing/algorithms/osgm.py" line="224" />
             <source>{}: must be positive (or empty), got {}</source>
             <translation>{} : doit être positif (ou vide), reçu {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="263" />
+            <location filename="../processing/algorithms/osgm.py" line="235" />
             <source>Z_SURFACE: expected a raster file (GeoTIFF), got {!r}</source>
             <translation>Z_SURFACE : fichier raster (GeoTIFF) attendu, reçu {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="31" />
+            <location filename="../processing/algorithms/pipeline.py" line="29" />
             <source>Photos to true orthophoto (whole pipeline)</source>
             <translation>Des photos à l'orthophoto vraie (chaîne complète)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="117" />
+            <location filename="../processing/algorithms/pipeline.py" line="88" />
             <source>DSM (filtered)</source>
             <translation>MNS (filtré)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="120" />
+            <location filename="../processing/algorithms/pipeline.py" line="91" />
             <source>True orthophoto</source>
             <translation>Orthophoto vraie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="121" />
+            <location filename="../processing/algorithms/pipeline.py" line="92" />
             <source>Occlusion mask</source>
             <translation>Masque d'occultation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="122" />
+            <location filename="../processing/algorithms/pipeline.py" line="93" />
             <source>Seamlines</source>
             <translation>Lignes de raccord</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="75" />
+            <location filename="../processing/algorithms/pipeline.py" line="72" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Résolution du MNS et de l'orthophoto vraie (m, 0 = taille du pixel au sol)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="83" />
+            <location filename="../processing/algorithms/pipeline.py" line="80" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Réutiliser un orientation.json existant dans le dossier de sortie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="137" />
+            <location filename="../processing/algorithms/pipeline.py" line="108" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES : indiquez le dossier des photos</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="152" />
+            <location filename="../processing/algorithms/pipeline.py" line="123" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER : indiquez un dossier pour les produits</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="162" />
+            <location filename="../processing/algorithms/pipeline.py" line="133" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION : nombre positif de mètres ou 0 attendu</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="196" />
+            <location filename="../processing/algorithms/pipeline.py" line="167" />
             <source>DSM (TruOrtho)</source>
             <translation>MNS (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="197" />
+            <location filename="../processing/algorithms/pipeline.py" line="168" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>Orthophoto vraie (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="198" />
+            <location filename="../processing/algorithms/pipeline.py" line="169" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Occultation (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="199" />
+            <location filename="../processing/algorithms/pipeline.py" line="170" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Lignes de raccord (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="182" />
+            <location filename="../processing/algorithms/pipeline.py" line="153" />
             <source>Tiles ran on: {}</source>
             <translation>Tuiles calculées sur : {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="181" />
+            <location filename="../processing/algorithms/pipeline.py" line="152" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{} : {:.1f} s, pic {:.0f} Mo ; {}</translation>
         </message>
@@ -869,62 +869,62 @@
             <translation>Jeu de données EPT : {} (à ajouter comme couche nuage de points)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="73" />
+            <location filename="../processing/algorithms/trueortho.py" line="68" />
             <source>Surface: DSM raster or mesh</source>
             <translation>Surface : raster MNS ou maillage</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="78" />
+            <location filename="../processing/algorithms/trueortho.py" line="73" />
             <source>Extent (default: the surface's)</source>
             <translation>Emprise (par défaut : celle de la surface)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="83" />
+            <location filename="../processing/algorithms/trueortho.py" line="78" />
             <source>Resolution (CRS units; 0 = the surface's cell size)</source>
             <translation>Résolution (unités du SCR ; 0 = taille de cellule de la surface)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="90" />
+            <location filename="../processing/algorithms/trueortho.py" line="85" />
             <source>Output CRS (default: the orientation's)</source>
             <translation>SCR de sortie (par défaut : celui de l'orientation)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="92" />
+            <location filename="../processing/algorithms/trueortho.py" line="87" />
             <source>Colour correction</source>
             <translation>Correction colorimétrique</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="96" />
+            <location filename="../processing/algorithms/trueortho.py" line="91" />
             <source>Maximum off-nadir viewing angle (degrees)</source>
             <translation>Angle de visée maximal par rapport au nadir (degrés)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="106" />
+            <location filename="../processing/algorithms/trueortho.py" line="101" />
             <source>Blend width across seamlines (cells)</source>
             <translation>Largeur du fondu aux lignes de raccord (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="154" />
+            <location filename="../processing/algorithms/trueortho.py" line="123" />
             <source>Source image index</source>
             <translation>Index de l'image source</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="165" />
+            <location filename="../processing/algorithms/trueortho.py" line="134" />
             <source>Seamlines (source image regions)</source>
             <translation>Lignes de raccord (zones des images sources)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="180" />
+            <location filename="../processing/algorithms/trueortho.py" line="149" />
             <source>SURFACE: give a DSM raster or a mesh file</source>
             <translation>SURFACE : indiquez un raster MNS ou un fichier de maillage</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="74" />
+            <location filename="../processing/algorithms/trueortho.py" line="69" />
             <source>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;All files (*.*)</source>
             <translation>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;Tous les fichiers (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="210" />
+            <location filename="../processing/algorithms/trueortho.py" line="179" />
             <source>{} x {} cells, {} images used, coverage {:.2%}, {} cells seen by no image</source>
             <translation>{} x {} cellules, {} images utilisées, couverture {:.2%}, {} cellules vues par aucune image</translation>
         </message>
@@ -934,362 +934,362 @@
             <translation>Annulé par l'utilisateur</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="16" />
-            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
-            <translation>Importe l'orientation d'un bloc d'images (orientation interne et externe de chaque image, points épars) depuis des fichiers COLMAP, Orthority ou OpenSfM/ODM dans le JSON d'orientation de TruOrtho, et écrit une couche des centres de projection et une couche des emprises des images. Les conventions (axes de la caméra, rotations, origine des pixels) sont converties à l'import ; voir le README, 'Formats and conventions'.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="24" />
-            <source>COLMAP text model (cameras.txt, images.txt or points3D.txt; the folder is used, with an optional georef.json {"crs": ..., "offset": [E, N, H]}), Orthority exterior CSV (filename, x, y, z, omega, phi, kappa[, camera]; degrees), OpenSfM/ODM reconstruction.json, or a TruOrtho orientation JSON.</source>
-            <translation>Modèle texte COLMAP (cameras.txt, images.txt ou points3D.txt ; le dossier est utilisé, avec un georef.json facultatif {"crs": ..., "offset": [E, N, H]}), CSV d'orientation externe Orthority (filename, x, y, z, omega, phi, kappa[, camera] ; degrés), reconstruction.json OpenSfM/ODM, ou un JSON d'orientation TruOrtho.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="29" />
-            <source>Orthority interior parameter file (YAML or JSON); required with a CSV input.</source>
-            <translation>Fichier des paramètres internes Orthority (YAML ou JSON) ; obligatoire avec une entrée CSV.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="30" />
-            <source>CRS of the input coordinates when the file does not state it (CSV without .prj, COLMAP without georef.json); target CRS for OpenSfM's topocentric frame.</source>
-            <translation>SCR des coordonnées d'entrée lorsque le fichier ne l'indique pas (CSV sans .prj, COLMAP sans georef.json) ; SCR cible pour le repère topocentrique d'OpenSfM.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="32" />
-            <source>Folder holding the images; every image of the block must be present there.</source>
-            <translation>Dossier contenant les images ; chaque image du bloc doit s'y trouver.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="33" />
-            <source>Optional ground control: point layer with 'name', 'role' (gcp|check), PointZ or a 'z' field, optional 'sigma_xy'/'sigma_z' in metres. Reprojected to the orientation's CRS.</source>
-            <translation>Points d'appui facultatifs : couche de points avec 'name', 'role' (gcp|check), PointZ ou un champ 'z', et facultativement 'sigma_xy'/'sigma_z' en mètres. Reprojetés dans le SCR de l'orientation.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="35" />
-            <source>Image measurements of the GCPs: table with 'gcp', 'image', 'x', 'y' in pixels ((0, 0) = centre of the top-left pixel).</source>
-            <translation>Mesures image des points d'appui : table avec 'gcp', 'image', 'x', 'y' en pixels ((0, 0) = centre du pixel en haut à gauche).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="37" />
-            <source>Height (in the CRS) of the plane the footprints are drawn on; default the median height of the sparse points, or of the GCPs, or 0.</source>
-            <translation>Hauteur (dans le SCR) du plan sur lequel les emprises sont tracées ; par défaut la hauteur médiane des points épars, sinon des points d'appui, sinon 0.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="39" />
-            <source>The orientation JSON (TruOrtho format, version 1).</source>
-            <translation>Le JSON d'orientation (format TruOrtho, version 1).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="40" />
-            <source>Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees).</source>
-            <translation>Centres de projection en PointZ avec name, camera, x, y, z, omega, phi, kappa (degrés).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="42" />
-            <source>Image footprints on the horizontal plane at FOOTPRINT_HEIGHT.</source>
-            <translation>Emprises des images sur le plan horizontal à la hauteur FOOTPRINT_HEIGHT.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="47" />
-            <source>Exports a TruOrtho orientation JSON to a COLMAP text model (cameras.txt, images.txt, points3D.txt and georef.json) or to Orthority frame-camera files (exterior.csv with a .prj sidecar and interior.yaml).</source>
-            <translation>Exporte un JSON d'orientation TruOrtho vers un modèle texte COLMAP (cameras.txt, images.txt, points3D.txt et georef.json) ou vers des fichiers Orthority de caméra à cadre (exterior.csv avec un fichier annexe .prj et interior.yaml).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="52" />
-            <source>A TruOrtho orientation JSON.</source>
-            <translation>Un JSON d'orientation TruOrtho.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="53" />
-            <source>colmap or opk (Orthority CSV + interior file).</source>
-            <translation>colmap ou opk (CSV Orthority + fichier d'orientation interne).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="54" />
-            <source>Folder the files are written to (created if needed).</source>
-            <translation>Dossier dans lequel les fichiers sont écrits (créé si nécessaire).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="59" />
-            <source>Reads an ODM/OpenSfM gcp_list.txt (first line EPSG code, PROJ string or 'WGS84 UTM nnX'; then 'X Y Z px py image [name]') into a GCP point layer and an observation table, the two inputs ground control takes everywhere in TruOrtho.</source>
-            <translation>Lit un fichier gcp_list.txt d'ODM/OpenSfM (première ligne : code EPSG, chaîne PROJ ou 'WGS84 UTM nnX' ; puis 'X Y Z px py image [name]') dans une couche de points d'appui et une table d'observations, les deux entrées qu'utilisent les points d'appui partout dans TruOrtho.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="64" />
-            <source>The gcp_list.txt file.</source>
-            <translation>Le fichier gcp_list.txt.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="65" />
-            <source>Comma-separated GCP names to mark as check points (role 'check').</source>
-            <translation>Noms de points d'appui, séparés par des virgules, à marquer comme points de contrôle (rôle 'check').</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="66" />
-            <source>Default planimetric standard deviation of the GCP coordinates, metres.</source>
-            <translation>Écart type planimétrique par défaut des coordonnées des points d'appui, en mètres.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="67" />
-            <source>Default height standard deviation of the GCP coordinates, metres.</source>
-            <translation>Écart type altimétrique par défaut des coordonnées des points d'appui, en mètres.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="68" />
-            <source>Optional CRS to reproject the GCPs to (default: the file's CRS).</source>
-            <translation>SCR facultatif dans lequel reprojeter les points d'appui (par défaut : le SCR du fichier).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="69" />
-            <source>GCP point layer (PointZ): name, role, z, sigma_xy, sigma_z.</source>
-            <translation>Couche des points d'appui (PointZ) : name, role, z, sigma_xy, sigma_z.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="70" />
-            <source>Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the top-left pixel, as in gcp_list.txt).</source>
-            <translation>Table d'observations : gcp, image, x, y (pixels, (0, 0) = centre du pixel en haut à gauche, comme dans gcp_list.txt).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="76" />
-            <source>Orients a block of overlapping photos: SIFT features at a working resolution, pair selection (exhaustive for small blocks, EXIF GNSS footprints, or a low-resolution retrieval pass), robust two-view geometry, tie-point tracks decimated on a grid by multiplicity, incremental reconstruction and a bundle block adjustment written for TruOrtho (collinearity equations with Brown distortion, Levenberg-Marquardt with the Schur complement, Huber loss, self-calibration). Ground control fixes the datum (7-parameter similarity, then weighted GCP observations); check points never enter the adjustment and are reported with per-axis RMSE. Without GCPs, EXIF GNSS positions serve as weighted priors; without either the block stays in an arbitrary frame.</source>
-            <translation>Oriente un bloc de photos qui se recouvrent : points caractéristiques SIFT à une résolution de travail, sélection des paires (exhaustive pour les petits blocs, emprises issues du GNSS EXIF, ou une passe de recherche à basse résolution), géométrie robuste à deux vues, pistes de points de liaison éclaircies sur une grille selon leur multiplicité, reconstruction incrémentale et une compensation par faisceaux écrite pour TruOrtho (équations de colinéarité avec distorsion de Brown, Levenberg-Marquardt avec le complément de Schur, perte de Huber, autocalibration). Les points d'appui fixent le datum (similitude à 7 paramètres, puis observations pondérées des points d'appui) ; les points de contrôle n'entrent jamais dans la compensation et sont rapportés avec l'EMQ par axe. Sans points d'appui, les positions GNSS EXIF servent d'a priori pondérés ; sans l'un ni l'autre, le bloc reste dans un repère arbitraire.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="86" />
-            <source>Folder of the images (non-image files are skipped with a warning in the report).</source>
-            <translation>Dossier des images (les fichiers qui ne sont pas des images sont ignorés avec un avertissement dans le rapport).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="87" />
-            <source>The image files, instead of a folder.</source>
-            <translation>Les fichiers image, au lieu d'un dossier.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="88" />
-            <source>Interior orientation: an Orthority interior file (YAML/JSON) or a text file with the 3x3 matrix K, taken as a calibration and held fixed. Without it: EXIF focal length and sensor size, else f = 1.2 x max(w, h), refined by self-calibration.</source>
-            <translation>Orientation interne : un fichier interne Orthority (YAML/JSON) ou un fichier texte avec la matrice 3x3 K, pris comme étalonnage et maintenu fixe. Sans lui : focale et taille du capteur EXIF, sinon f = 1,2 x max(w, h), affinés par autocalibration.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="91" />
-            <source>Ground control and check points: point layer with 'name', 'role' (gcp|check), PointZ or 'z', optional 'sigma_xy'/'sigma_z' (metres). Reprojected to CRS.</source>
-            <translation>Points d'appui et de contrôle : couche de points avec 'name', 'role' (gcp|check), PointZ ou 'z', facultativement 'sigma_xy'/'sigma_z' (mètres). Reprojetés dans CRS.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="93" />
-            <source>Image measurements of the GCPs: table with 'gcp', 'image' (file name), 'x', 'y' (pixels, (0, 0) = centre of the top-left pixel).</source>
-            <translation>Mesures image des points d'appui : table avec 'gcp', 'image' (nom de fichier), 'x', 'y' (pixels, (0, 0) = centre du pixel en haut à gauche).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="95" />
-            <source>CRS of the output (default: the GCP layer's, else the UTM zone of the EXIF GNSS positions).</source>
-            <translation>SCR de la sortie (par défaut : celui de la couche des points d'appui, sinon la zone UTM des positions GNSS EXIF).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="97" />
-            <source>Larger image side at which features are detected, pixels.</source>
-            <translation>Plus grand côté de l'image auquel les points caractéristiques sont détectés, en pixels.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="98" />
-            <source>Features kept per image.</source>
-            <translation>Points caractéristiques conservés par image.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="99" />
-            <source>Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment when no CAMERA file is given (else hold the prior interior orientation).</source>
-            <translation>Estimer f, cx, cy, k1, k2, p1, p2 dans la compensation lorsqu'aucun fichier CAMERA n'est fourni (sinon maintenir l'orientation interne a priori).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="101" />
-            <source>The adjusted orientation (TruOrtho JSON).</source>
-            <translation>L'orientation compensée (JSON TruOrtho).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="102" />
-            <source>HTML report (and a JSON file of the same name): sigma0, image RMS, per-image residuals, GCP and check point tables, residual vector plots, tie-point multiplicity histogram, block overview.</source>
-            <translation>Rapport HTML (et un fichier JSON du même nom) : sigma0, EMQ image, résidus par image, tables des points d'appui et de contrôle, graphiques des vecteurs résidus, histogramme de multiplicité des points de liaison, vue d'ensemble du bloc.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="105" />
-            <source>Projection centres (PointZ) with omega, phi, kappa.</source>
-            <translation>Centres de projection (PointZ) avec omega, phi, kappa.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="106" />
-            <source>Tie points (PointZ) with multiplicity, mean reprojection error and colour.</source>
-            <translation>Points de liaison (PointZ) avec multiplicité, erreur de reprojection moyenne et couleur.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="107" />
-            <source>GCPs and check points with dX, dY, dZ (adjusted or triangulated minus surveyed).</source>
-            <translation>Points d'appui et de contrôle avec dX, dY, dZ (compensés ou triangulés moins levés).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="113" />
-            <source>The whole chain from photos to a true orthophoto in one run: image orientation with the ground control (bundle block adjustment), dense matching in object space (OSGM), DSM filtering, a mesh, and the true orthophoto with its occlusion mask and seamlines, plus one HTML report (block overview, sigma0, GCP and check point tables, residual plot, DSM hillshade, true-orthophoto preview, time and memory per stage). The products are written to OUTPUT_FOLDER with fixed names: orientation.json, report.html, dsm.tif, pointcloud.laz, mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (and the raw DSM, confidence and orthoimage of the matching).</source>
-            <translation>Toute la chaîne des photos à l'orthophoto vraie en une seule exécution : orientation des images avec les points d'appui (compensation par faisceaux), appariement dense dans l'espace objet (OSGM), filtrage du MNS, un maillage, et l'orthophoto vraie avec son masque d'occultation et ses lignes de raccord, plus un rapport HTML (vue d'ensemble du bloc, sigma0, tables des points d'appui et de contrôle, graphique des résidus, ombrage du MNS, aperçu de l'orthophoto vraie, temps et mémoire par étape). Les produits sont écrits dans OUTPUT_FOLDER sous des noms fixes : orientation.json, report.html, dsm.tif, pointcloud.laz, mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (ainsi que le MNS brut, la confiance et l'orthoimage de l'appariement).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="123" />
-            <source>Folder of the photos (JPEG, TIFF, PNG...); other files are skipped.</source>
-            <translation>Dossier des photos (JPEG, TIFF, PNG...) ; les autres fichiers sont ignorés.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="124" />
-            <source>Optional interior orientation (Orthority YAML/JSON or a 3x3 K text file), held fixed; otherwise EXIF priors refined by self-calibration.</source>
-            <translation>Orientation interne facultative (YAML/JSON Orthority ou fichier texte de la matrice 3x3 K), maintenue fixe ; sinon des valeurs a priori EXIF affinées par autocalibration.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="126" />
-            <source>Optional point layer of ground control and check points (fields name, role gcp|check, optional z, sigma_xy, sigma_z), as for Orient images. Needed for a georeferenced product unless the photos carry EXIF GNSS positions.</source>
-            <translation>Couche de points facultative des points d'appui et de contrôle (champs name, role gcp|check, facultativement z, sigma_xy, sigma_z), comme pour Orienter les images. Nécessaire pour un produit géoréférencé, sauf si les photos portent des positions GNSS EXIF.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="129" />
-            <source>Table of the GCP image measurements (gcp, image, x, y), given with GCPS.</source>
-            <translation>Table des mesures image des points d'appui (gcp, image, x, y), fournie avec GCPS.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="130" />
-            <source>CRS of the products; default the GCP layer's CRS.</source>
-            <translation>SCR des produits ; par défaut le SCR de la couche des points d'appui.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="131" />
-            <source>Cell size of the DSM and the true orthophoto in metres; 0 = the median ground sample distance of the near-nadir images.</source>
-            <translation>Taille de cellule du MNS et de l'orthophoto vraie en mètres ; 0 = taille médiane du pixel au sol des images proches du nadir.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="133" />
-            <source>Skip the orientation when OUTPUT_FOLDER already holds orientation.json (e.g. to rerun matching and the orthophoto with another resolution).</source>
-            <translation>Sauter l'orientation lorsque OUTPUT_FOLDER contient déjà orientation.json (par ex. pour relancer l'appariement et l'orthophoto avec une autre résolution).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="135" />
-            <source>Where the tiles of dense matching, DSM filtering and the true orthophoto are computed, by one executor for the three stages (a local cluster starts once); the products are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the photos and OUTPUT_FOLDER at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The orientation, the mesh and the report are computed in QGIS's process. The address is checked before the orientation starts; the scheduler is first contacted by dense matching.</source>
-            <translation>Où les tuiles de l'appariement dense, du filtrage du MNS et de l'orthophoto vraie sont calculées, par un seul exécuteur pour les trois étapes (une grappe locale ne démarre qu'une fois) ; les produits sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, une tuile après l'autre sur tous les cœurs (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire les photos et OUTPUT_FOLDER aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. L'orientation, le maillage et le rapport sont calculés dans le processus de QGIS. L'adresse est vérifiée avant le début de l'orientation ; l'ordonnanceur est contacté pour la première fois par l'appariement dense.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="145" />
+            <location filename="../processing/help/__init__.py" line="14" />
             <source>Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. Security: a Dask scheduler executes any code its clients send, so it must never be reachable unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address that is not on this computer is refused.</source>
             <translation>Adresse du planificateur Dask pour EXECUTOR = scheduler : tls://hôte:8786, ou le chemin d'un fichier de planificateur ; vide = la variable d'environnement TRUORTHO_DASK_SCHEDULER. Sécurité : un planificateur Dask exécute tout code que ses clients lui envoient, il ne doit donc jamais être joignable sans authentification. Utilisez TLS avec des certificats pour un planificateur distant (configuré dans la configuration de Dask, distributed.comm.tls), ou un tunnel SSH vers 127.0.0.1 ; une adresse tcp:// simple qui n'est pas sur cet ordinateur est refusée.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="151" />
+            <location filename="../processing/help/__init__.py" line="26" />
+            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
+            <translation>Importe l'orientation d'un bloc d'images (orientation interne et externe de chaque image, points épars) depuis des fichiers COLMAP, Orthority ou OpenSfM/ODM dans le JSON d'orientation de TruOrtho, et écrit une couche des centres de projection et une couche des emprises des images. Les conventions (axes de la caméra, rotations, origine des pixels) sont converties à l'import ; voir le README, 'Formats and conventions'.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="34" />
+            <source>COLMAP text model (cameras.txt, images.txt or points3D.txt; the folder is used, with an optional georef.json {"crs": ..., "offset": [E, N, H]}), Orthority exterior CSV (filename, x, y, z, omega, phi, kappa[, camera]; degrees), OpenSfM/ODM reconstruction.json, or a TruOrtho orientation JSON.</source>
+            <translation>Modèle texte COLMAP (cameras.txt, images.txt ou points3D.txt ; le dossier est utilisé, avec un georef.json facultatif {"crs": ..., "offset": [E, N, H]}), CSV d'orientation externe Orthority (filename, x, y, z, omega, phi, kappa[, camera] ; degrés), reconstruction.json OpenSfM/ODM, ou un JSON d'orientation TruOrtho.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="39" />
+            <source>Orthority interior parameter file (YAML or JSON); required with a CSV input.</source>
+            <translation>Fichier des paramètres internes Orthority (YAML ou JSON) ; obligatoire avec une entrée CSV.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="40" />
+            <source>CRS of the input coordinates when the file does not state it (CSV without .prj, COLMAP without georef.json); target CRS for OpenSfM's topocentric frame.</source>
+            <translation>SCR des coordonnées d'entrée lorsque le fichier ne l'indique pas (CSV sans .prj, COLMAP sans georef.json) ; SCR cible pour le repère topocentrique d'OpenSfM.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="42" />
+            <source>Folder holding the images; every image of the block must be present there.</source>
+            <translation>Dossier contenant les images ; chaque image du bloc doit s'y trouver.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="43" />
+            <source>Optional ground control: point layer with 'name', 'role' (gcp|check), PointZ or a 'z' field, optional 'sigma_xy'/'sigma_z' in metres. Reprojected to the orientation's CRS.</source>
+            <translation>Points d'appui facultatifs : couche de points avec 'name', 'role' (gcp|check), PointZ ou un champ 'z', et facultativement 'sigma_xy'/'sigma_z' en mètres. Reprojetés dans le SCR de l'orientation.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="45" />
+            <source>Image measurements of the GCPs: table with 'gcp', 'image', 'x', 'y' in pixels ((0, 0) = centre of the top-left pixel).</source>
+            <translation>Mesures image des points d'appui : table avec 'gcp', 'image', 'x', 'y' en pixels ((0, 0) = centre du pixel en haut à gauche).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="47" />
+            <source>Height (in the CRS) of the plane the footprints are drawn on; default the median height of the sparse points, or of the GCPs, or 0.</source>
+            <translation>Hauteur (dans le SCR) du plan sur lequel les emprises sont tracées ; par défaut la hauteur médiane des points épars, sinon des points d'appui, sinon 0.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="49" />
+            <source>The orientation JSON (TruOrtho format, version 1).</source>
+            <translation>Le JSON d'orientation (format TruOrtho, version 1).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="50" />
+            <source>Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees).</source>
+            <translation>Centres de projection en PointZ avec name, camera, x, y, z, omega, phi, kappa (degrés).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="52" />
+            <source>Image footprints on the horizontal plane at FOOTPRINT_HEIGHT.</source>
+            <translation>Emprises des images sur le plan horizontal à la hauteur FOOTPRINT_HEIGHT.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="57" />
+            <source>Exports a TruOrtho orientation JSON to a COLMAP text model (cameras.txt, images.txt, points3D.txt and georef.json) or to Orthority frame-camera files (exterior.csv with a .prj sidecar and interior.yaml).</source>
+            <translation>Exporte un JSON d'orientation TruOrtho vers un modèle texte COLMAP (cameras.txt, images.txt, points3D.txt et georef.json) ou vers des fichiers Orthority de caméra à cadre (exterior.csv avec un fichier annexe .prj et interior.yaml).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="62" />
+            <source>A TruOrtho orientation JSON.</source>
+            <translation>Un JSON d'orientation TruOrtho.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="63" />
+            <source>colmap or opk (Orthority CSV + interior file).</source>
+            <translation>colmap ou opk (CSV Orthority + fichier d'orientation interne).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="64" />
+            <source>Folder the files are written to (created if needed).</source>
+            <translation>Dossier dans lequel les fichiers sont écrits (créé si nécessaire).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="69" />
+            <source>Reads an ODM/OpenSfM gcp_list.txt (first line EPSG code, PROJ string or 'WGS84 UTM nnX'; then 'X Y Z px py image [name]') into a GCP point layer and an observation table, the two inputs ground control takes everywhere in TruOrtho.</source>
+            <translation>Lit un fichier gcp_list.txt d'ODM/OpenSfM (première ligne : code EPSG, chaîne PROJ ou 'WGS84 UTM nnX' ; puis 'X Y Z px py image [name]') dans une couche de points d'appui et une table d'observations, les deux entrées qu'utilisent les points d'appui partout dans TruOrtho.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="74" />
+            <source>The gcp_list.txt file.</source>
+            <translation>Le fichier gcp_list.txt.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="75" />
+            <source>Comma-separated GCP names to mark as check points (role 'check').</source>
+            <translation>Noms de points d'appui, séparés par des virgules, à marquer comme points de contrôle (rôle 'check').</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="76" />
+            <source>Default planimetric standard deviation of the GCP coordinates, metres.</source>
+            <translation>Écart type planimétrique par défaut des coordonnées des points d'appui, en mètres.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="77" />
+            <source>Default height standard deviation of the GCP coordinates, metres.</source>
+            <translation>Écart type altimétrique par défaut des coordonnées des points d'appui, en mètres.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="78" />
+            <source>Optional CRS to reproject the GCPs to (default: the file's CRS).</source>
+            <translation>SCR facultatif dans lequel reprojeter les points d'appui (par défaut : le SCR du fichier).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="79" />
+            <source>GCP point layer (PointZ): name, role, z, sigma_xy, sigma_z.</source>
+            <translation>Couche des points d'appui (PointZ) : name, role, z, sigma_xy, sigma_z.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="80" />
+            <source>Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the top-left pixel, as in gcp_list.txt).</source>
+            <translation>Table d'observations : gcp, image, x, y (pixels, (0, 0) = centre du pixel en haut à gauche, comme dans gcp_list.txt).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="86" />
+            <source>Orients a block of overlapping photos: SIFT features at a working resolution, pair selection (exhaustive for small blocks, EXIF GNSS footprints, or a low-resolution retrieval pass), robust two-view geometry, tie-point tracks decimated on a grid by multiplicity, incremental reconstruction and a bundle block adjustment written for TruOrtho (collinearity equations with Brown distortion, Levenberg-Marquardt with the Schur complement, Huber loss, self-calibration). Ground control fixes the datum (7-parameter similarity, then weighted GCP observations); check points never enter the adjustment and are reported with per-axis RMSE. Without GCPs, EXIF GNSS positions serve as weighted priors; without either the block stays in an arbitrary frame.</source>
+            <translation>Oriente un bloc de photos qui se recouvrent : points caractéristiques SIFT à une résolution de travail, sélection des paires (exhaustive pour les petits blocs, emprises issues du GNSS EXIF, ou une passe de recherche à basse résolution), géométrie robuste à deux vues, pistes de points de liaison éclaircies sur une grille selon leur multiplicité, reconstruction incrémentale et une compensation par faisceaux écrite pour TruOrtho (équations de colinéarité avec distorsion de Brown, Levenberg-Marquardt avec le complément de Schur, perte de Huber, autocalibration). Les points d'appui fixent le datum (similitude à 7 paramètres, puis observations pondérées des points d'appui) ; les points de contrôle n'entrent jamais dans la compensation et sont rapportés avec l'EMQ par axe. Sans points d'appui, les positions GNSS EXIF servent d'a priori pondérés ; sans l'un ni l'autre, le bloc reste dans un repère arbitraire.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="96" />
+            <source>Folder of the images (non-image files are skipped with a warning in the report).</source>
+            <translation>Dossier des images (les fichiers qui ne sont pas des images sont ignorés avec un avertissement dans le rapport).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="97" />
+            <source>The image files, instead of a folder.</source>
+            <translation>Les fichiers image, au lieu d'un dossier.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="98" />
+            <source>Interior orientation: an Orthority interior file (YAML/JSON) or a text file with the 3x3 matrix K, taken as a calibration and held fixed. Without it: EXIF focal length and sensor size, else f = 1.2 x max(w, h), refined by self-calibration.</source>
+            <translation>Orientation interne : un fichier interne Orthority (YAML/JSON) ou un fichier texte avec la matrice 3x3 K, pris comme étalonnage et maintenu fixe. Sans lui : focale et taille du capteur EXIF, sinon f = 1,2 x max(w, h), affinés par autocalibration.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="101" />
+            <source>Ground control and check points: point layer with 'name', 'role' (gcp|check), PointZ or 'z', optional 'sigma_xy'/'sigma_z' (metres). Reprojected to CRS.</source>
+            <translation>Points d'appui et de contrôle : couche de points avec 'name', 'role' (gcp|check), PointZ ou 'z', facultativement 'sigma_xy'/'sigma_z' (mètres). Reprojetés dans CRS.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="103" />
+            <source>Image measurements of the GCPs: table with 'gcp', 'image' (file name), 'x', 'y' (pixels, (0, 0) = centre of the top-left pixel).</source>
+            <translation>Mesures image des points d'appui : table avec 'gcp', 'image' (nom de fichier), 'x', 'y' (pixels, (0, 0) = centre du pixel en haut à gauche).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="105" />
+            <source>CRS of the output (default: the GCP layer's, else the UTM zone of the EXIF GNSS positions).</source>
+            <translation>SCR de la sortie (par défaut : celui de la couche des points d'appui, sinon la zone UTM des positions GNSS EXIF).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="107" />
+            <source>Larger image side at which features are detected, pixels.</source>
+            <translation>Plus grand côté de l'image auquel les points caractéristiques sont détectés, en pixels.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="108" />
+            <source>Features kept per image.</source>
+            <translation>Points caractéristiques conservés par image.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="109" />
+            <source>Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment when no CAMERA file is given (else hold the prior interior orientation).</source>
+            <translation>Estimer f, cx, cy, k1, k2, p1, p2 dans la compensation lorsqu'aucun fichier CAMERA n'est fourni (sinon maintenir l'orientation interne a priori).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="111" />
+            <source>The adjusted orientation (TruOrtho JSON).</source>
+            <translation>L'orientation compensée (JSON TruOrtho).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="112" />
+            <source>HTML report (and a JSON file of the same name): sigma0, image RMS, per-image residuals, GCP and check point tables, residual vector plots, tie-point multiplicity histogram, block overview.</source>
+            <translation>Rapport HTML (et un fichier JSON du même nom) : sigma0, EMQ image, résidus par image, tables des points d'appui et de contrôle, graphiques des vecteurs résidus, histogramme de multiplicité des points de liaison, vue d'ensemble du bloc.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="115" />
+            <source>Projection centres (PointZ) with omega, phi, kappa.</source>
+            <translation>Centres de projection (PointZ) avec omega, phi, kappa.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="116" />
+            <source>Tie points (PointZ) with multiplicity, mean reprojection error and colour.</source>
+            <translation>Points de liaison (PointZ) avec multiplicité, erreur de reprojection moyenne et couleur.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="117" />
+            <source>GCPs and check points with dX, dY, dZ (adjusted or triangulated minus surveyed).</source>
+            <translation>Points d'appui et de contrôle avec dX, dY, dZ (compensés ou triangulés moins levés).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="123" />
+            <source>The whole chain from photos to a true orthophoto in one run: image orientation with the ground control (bundle block adjustment), dense matching in object space (OSGM), DSM filtering, a mesh, and the true orthophoto with its occlusion mask and seamlines, plus one HTML report (block overview, sigma0, GCP and check point tables, residual plot, DSM hillshade, true-orthophoto preview, time and memory per stage). The products are written to OUTPUT_FOLDER with fixed names: orientation.json, report.html, dsm.tif, pointcloud.laz, mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (and the raw DSM, confidence and orthoimage of the matching).</source>
+            <translation>Toute la chaîne des photos à l'orthophoto vraie en une seule exécution : orientation des images avec les points d'appui (compensation par faisceaux), appariement dense dans l'espace objet (OSGM), filtrage du MNS, un maillage, et l'orthophoto vraie avec son masque d'occultation et ses lignes de raccord, plus un rapport HTML (vue d'ensemble du bloc, sigma0, tables des points d'appui et de contrôle, graphique des résidus, ombrage du MNS, aperçu de l'orthophoto vraie, temps et mémoire par étape). Les produits sont écrits dans OUTPUT_FOLDER sous des noms fixes : orientation.json, report.html, dsm.tif, pointcloud.laz, mesh.ply, trueortho.tif, occlusion.tif, seamlines.gpkg (ainsi que le MNS brut, la confiance et l'orthoimage de l'appariement).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="133" />
+            <source>Folder of the photos (JPEG, TIFF, PNG...); other files are skipped.</source>
+            <translation>Dossier des photos (JPEG, TIFF, PNG...) ; les autres fichiers sont ignorés.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="134" />
+            <source>Optional interior orientation (Orthority YAML/JSON or a 3x3 K text file), held fixed; otherwise EXIF priors refined by self-calibration.</source>
+            <translation>Orientation interne facultative (YAML/JSON Orthority ou fichier texte de la matrice 3x3 K), maintenue fixe ; sinon des valeurs a priori EXIF affinées par autocalibration.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="136" />
+            <source>Optional point layer of ground control and check points (fields name, role gcp|check, optional z, sigma_xy, sigma_z), as for Orient images. Needed for a georeferenced product unless the photos carry EXIF GNSS positions.</source>
+            <translation>Couche de points facultative des points d'appui et de contrôle (champs name, role gcp|check, facultativement z, sigma_xy, sigma_z), comme pour Orienter les images. Nécessaire pour un produit géoréférencé, sauf si les photos portent des positions GNSS EXIF.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="139" />
+            <source>Table of the GCP image measurements (gcp, image, x, y), given with GCPS.</source>
+            <translation>Table des mesures image des points d'appui (gcp, image, x, y), fournie avec GCPS.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="140" />
+            <source>CRS of the products; default the GCP layer's CRS.</source>
+            <translation>SCR des produits ; par défaut le SCR de la couche des points d'appui.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="141" />
+            <source>Cell size of the DSM and the true orthophoto in metres; 0 = the median ground sample distance of the near-nadir images.</source>
+            <translation>Taille de cellule du MNS et de l'orthophoto vraie en mètres ; 0 = taille médiane du pixel au sol des images proches du nadir.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="143" />
+            <source>Skip the orientation when OUTPUT_FOLDER already holds orientation.json (e.g. to rerun matching and the orthophoto with another resolution).</source>
+            <translation>Sauter l'orientation lorsque OUTPUT_FOLDER contient déjà orientation.json (par ex. pour relancer l'appariement et l'orthophoto avec une autre résolution).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="145" />
+            <source>Where the tiles of dense matching, DSM filtering and the true orthophoto are computed, by one executor for the three stages (a local cluster starts once); the products are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the photos and OUTPUT_FOLDER at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The orientation, the mesh and the report are computed in QGIS's process. The address is checked before the orientation starts; the scheduler is first contacted by dense matching.</source>
+            <translation>Où les tuiles de l'appariement dense, du filtrage du MNS et de l'orthophoto vraie sont calculées, par un seul exécuteur pour les trois étapes (une grappe locale ne démarre qu'une fois) ; les produits sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, une tuile après l'autre sur tous les cœurs (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire les photos et OUTPUT_FOLDER aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. L'orientation, le maillage et le rapport sont calculés dans le processus de QGIS. L'adresse est vérifiée avant le début de l'orientation ; l'ordonnanceur est contacté pour la première fois par l'appariement dense.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="156" />
             <source>Folder of the products (created when missing; existing products are replaced).</source>
             <translation>Dossier des produits (créé s'il manque ; les produits existants sont remplacés).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="152" />
+            <location filename="../processing/help/__init__.py" line="157" />
             <source>orientation.json: the adjusted orientation.</source>
             <translation>orientation.json : l'orientation compensée.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="153" />
+            <location filename="../processing/help/__init__.py" line="158" />
             <source>report.html (and report.json): the quality report of the run.</source>
             <translation>report.html (et report.json) : le rapport de qualité de l'exécution.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="154" />
+            <location filename="../processing/help/__init__.py" line="159" />
             <source>dsm.tif: the filtered DSM (float32, nodata -9999).</source>
             <translation>dsm.tif : le MNS filtré (float32, NoData -9999).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="155" />
+            <location filename="../processing/help/__init__.py" line="160" />
             <source>pointcloud.laz: the matched points with colour and confidence.</source>
             <translation>pointcloud.laz : les points appariés avec couleur et confiance.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="156" />
+            <location filename="../processing/help/__init__.py" line="161" />
             <source>mesh.ply: 2.5D mesh of the filtered DSM with vertical walls and vertex colours.</source>
             <translation>mesh.ply : maillage 2,5D du MNS filtré avec murs verticaux et couleurs des sommets.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="157" />
+            <location filename="../processing/help/__init__.py" line="162" />
             <source>trueortho.tif: the true orthophoto (bands of the photos + alpha, COG).</source>
             <translation>trueortho.tif : l'orthophoto vraie (bandes des photos + alpha, COG).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="158" />
+            <location filename="../processing/help/__init__.py" line="163" />
             <source>occlusion.tif: 1 where no photo sees the surface.</source>
             <translation>occlusion.tif : 1 là où aucune photo ne voit la surface.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="159" />
+            <location filename="../processing/help/__init__.py" line="164" />
             <source>seamlines.gpkg: one polygon per source photo.</source>
             <translation>seamlines.gpkg : un polygone par photo source.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="164" />
+            <location filename="../processing/help/__init__.py" line="169" />
             <source>Dense image matching in object space (OSGM): computes a DSM directly on a ground grid from the oriented images, without rectification or pairwise depth maps. For every tile of the grid the images that see it (at most MAX_IMAGES) are resampled onto the horizontal plane of every search height (voxels of RESOLUTION x RESOLUTION x Z_STEP); a matching cost from all of them per cell and height is aggregated by semi-global matching along 8 or 16 paths (penalty P1 for a change of one height step, P2 for larger jumps, lowered across image edges), and each cell takes the height of least aggregated cost, refined between steps, with a confidence in [0, 1]. Matching runs coarse to fine over an image pyramid, by tiles, with progress and cancel. Cells without a reliable match are nodata (filter and fill them with truortho:dsmfilter). Optionally writes the confidence, an orthoimage coloured from the matched images, and a point cloud; with OBLIQUE = auto, groups of oblique images are matched in extra reference systems along their viewing directions, whose points (facades) go to the point cloud.</source>
             <translation>Appariement dense d'images dans l'espace objet (OSGM) : calcule un MNS directement sur une grille au sol à partir des images orientées, sans rectification épipolaire ni cartes de profondeur par paires. Pour chaque tuile de la grille, les images qui la voient (au plus MAX_IMAGES) sont rééchantillonnées sur le plan horizontal de chaque hauteur de recherche (voxels de RESOLUTION x RESOLUTION x Z_STEP) ; un coût d'appariement calculé à partir de toutes ces images par cellule et par hauteur est agrégé par appariement semi-global le long de 8 ou 16 chemins (pénalité P1 pour un changement d'un pas de hauteur, P2 pour les sauts plus grands, réduite aux contours de l'image), et chaque cellule prend la hauteur de moindre coût agrégé, affinée entre les pas, avec une confiance dans [0, 1]. L'appariement procède du grossier au fin sur une pyramide d'images, par tuiles, avec progression et annulation. Les cellules sans appariement fiable sont en NoData (les filtrer et les combler avec truortho:dsmfilter). Écrit en option la confiance, une orthoimage colorée à partir des images appariées et un nuage de points ; avec OBLIQUE = auto, des groupes d'images obliques sont appariés dans des systèmes de référence supplémentaires orientés selon leurs directions de visée, dont les points (façades) vont dans le nuage de points.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="178" />
+            <location filename="../processing/help/__init__.py" line="183" />
             <source>Orientation JSON (from Orient images or Import orientation) with a projected CRS (metres) and at least two images, which must be on disk.</source>
             <translation>JSON d'orientation (issu de Orienter les images ou Importer une orientation) avec un SCR projeté (mètres) et au moins deux images, qui doivent être présentes sur le disque.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="180" />
+            <location filename="../processing/help/__init__.py" line="185" />
             <source>Area to match (reprojected to the orientation's CRS); default the extent of the sparse points (1-99 %), else the union of the near-nadir image footprints. It must intersect the area the images see.</source>
             <translation>Zone à apparier (reprojetée dans le SCR de l'orientation) ; par défaut l'emprise des points épars (1-99 %), sinon l'union des emprises des images proches du nadir. Elle doit intersecter la zone vue par les images.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="183" />
+            <location filename="../processing/help/__init__.py" line="188" />
             <source>Cell size of the DSM, metres; empty or 0 = the median ground sample distance of the near-nadir images.</source>
             <translation>Taille de cellule du MNS, en mètres ; vide ou 0 = taille médiane du pixel au sol des images proches du nadir.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="185" />
+            <location filename="../processing/help/__init__.py" line="190" />
             <source>Height step between two search planes, metres; empty or 0 = the resolution.</source>
             <translation>Pas de hauteur entre deux plans de recherche, en mètres ; vide ou 0 = la résolution.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="186" />
+            <location filename="../processing/help/__init__.py" line="191" />
             <source>Lowest height searched (world Z, the orientation's vertical datum); empty = from the sparse points (0.5 % percentile minus a margin), else from the GCP heights. Must be below Z_MAX.</source>
             <translation>Hauteur minimale recherchée (Z terrain, dans le référentiel altimétrique de l'orientation) ; vide = à partir des points épars (centile 0,5 % moins une marge), sinon à partir des hauteurs des points d'appui. Doit être inférieure à Z_MAX.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="189" />
+            <location filename="../processing/help/__init__.py" line="194" />
             <source>Highest height searched; empty = from the sparse points (99.5 % percentile plus a margin), else half the flying height above the highest GCP. Always kept below the cameras. Without sparse points or GCPs give Z_MIN and Z_MAX.</source>
             <translation>Hauteur maximale recherchée ; vide = à partir des points épars (centile 99,5 % plus une marge), sinon la moitié de la hauteur de vol au-dessus du point d'appui le plus haut. Toujours maintenue sous les caméras. Sans points épars ni points d'appui, indiquer Z_MIN et Z_MAX.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="192" />
+            <location filename="../processing/help/__init__.py" line="197" />
             <source>Optional coarse DSM or DTM raster: the search at each cell is bounded by the lowest and highest height of its neighbourhood plus a margin, which speeds up matching and avoids wrong heights on rough terrain.</source>
             <translation>Raster MNS ou MNT grossier facultatif : la recherche en chaque cellule est bornée par les hauteurs minimale et maximale de son voisinage plus une marge, ce qui accélère l'appariement et évite des hauteurs erronées sur un terrain accidenté.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="195" />
+            <location filename="../processing/help/__init__.py" line="200" />
             <source>Number of aggregation directions of semi-global matching: 8 (faster) or 16 (smoother slanted surfaces).</source>
             <translation>Nombre de directions d'agrégation de l'appariement semi-global : 8 (plus rapide) ou 16 (surfaces inclinées plus lisses).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="197" />
+            <location filename="../processing/help/__init__.py" line="202" />
             <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
             <translation>none : un seul système de référence au nadir (le MNS). auto : les groupes d'images obliques reçoivent en plus des systèmes de référence orientés selon leurs directions de visée, dont les points vont dans le nuage de points avec leur identifiant 'system'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="200" />
+            <location filename="../processing/help/__init__.py" line="205" />
             <source>Penalty for a change of one height step between neighbouring cells, in cost units (unrelated image windows cost 1023); empty = 256.</source>
             <translation>Pénalité pour un changement d'un pas de hauteur entre cellules voisines, en unités de coût (des fenêtres d'image sans rapport coûtent 1023) ; vide = 256.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="202" />
+            <location filename="../processing/help/__init__.py" line="207" />
             <source>Penalty for a larger height jump, above P1 and at most 3072; empty = 2048 (a jump then needs contrary evidence from two cells).</source>
             <translation>Pénalité pour un saut de hauteur plus grand, supérieure à P1 et au plus 3072 ; vide = 2048 (un saut exige alors des indices contraires provenant de deux cellules).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="204" />
+            <location filename="../processing/help/__init__.py" line="209" />
             <source>Largest number of images matched per tile (best coverage first, then the most nadir); memory and time grow with it.</source>
             <translation>Nombre maximal d'images appariées par tuile (meilleure couverture d'abord, puis les plus proches du nadir) ; la mémoire et le temps de calcul augmentent avec lui.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="206" />
+            <location filename="../processing/help/__init__.py" line="211" />
             <source>Tile side in cells; memory grows with its square, the number of search heights and MAX_IMAGES.</source>
             <translation>Côté des tuiles en cellules ; la mémoire croît avec son carré, le nombre de hauteurs de recherche et MAX_IMAGES.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="208" />
+            <location filename="../processing/help/__init__.py" line="213" />
             <source>Where the tiles are matched; the DSM and confidence are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with the same inputs and parameters after a crash reuses them.</source>
             <translation>Où les tuiles sont appariées ; le MNS et la confiance sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, une tuile après l'autre sur tous les cœurs (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire les images aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. Les tuiles terminées sont gardées à côté du MNS (DSM.tif.tiles) jusqu'à la fin du traitement, de sorte qu'une nouvelle exécution avec les mêmes entrées et paramètres après un plantage les réutilise.</translation>
         </message>
@@ -1374,277 +1374,277 @@
             <translation>Où les tuiles de la mosaïque sont calculées ; l'orthophoto vraie, l'index des images sources, le masque d'occultation et les lignes de raccord sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, une tuile après l'autre (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire les images et la surface aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. La correction colorimétrique (sur une grille décimée) est estimée dans le processus de QGIS. Les tuiles terminées sont gardées dans un dossier à côté de la sortie (son nom suivi de « .tiles ») jusqu'à la réussite du traitement, de sorte qu'une nouvelle exécution avec les mêmes entrées et paramètres après un plantage les réutilise.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="279" />
+            <location filename="../processing/help/__init__.py" line="274" />
             <source>GeoTIFF with the images' bands and data type plus an alpha band, tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
             <translation>GeoTIFF avec les bandes et le type de données des images plus une bande alpha, tuilé, avec aperçus, au format Cloud-Optimized GeoTIFF.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="281" />
+            <location filename="../processing/help/__init__.py" line="276" />
             <source>Int16 GeoTIFF: index (0-based, orientation order) of the image each cell comes from; -1 = nodata.</source>
             <translation>GeoTIFF Int16 : index (à partir de 0, dans l'ordre de l'orientation) de l'image dont provient chaque cellule ; -1 = NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="283" />
+            <location filename="../processing/help/__init__.py" line="278" />
             <source>UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the surface has no data.</source>
             <translation>GeoTIFF UInt8 : 1 là où aucune image ne voit la cellule, 0 là où elle est vue, 255 là où la surface n'a pas de données.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="285" />
+            <location filename="../processing/help/__init__.py" line="280" />
             <source>Polygons, one feature per source image: the cells it colours (image_index, image, cells, area).</source>
             <translation>Polygones, une entité par image source : les cellules qu'elle colore (image_index, image, cells, area).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="291" />
+            <location filename="../processing/help/__init__.py" line="286" />
             <source>Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the cells of blurred height steps to the nearer side, removes outliers (cells that depart from the confidence-weighted median of their window by more than the threshold and have too few neighbours at their height, so roof edges and corners survive), fills holes up to a maximum width by harmonic interpolation (holes at the foot of walls from the ground side only; wider holes stay nodata and are reported), and optionally smooths planar surfaces without blurring their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the statistics (removed outliers, filled cells, remaining holes) are returned and logged.</source>
             <translation>Nettoie un MNS brut (par ex. le MNS d'appariement dense de l'étape OSGM de TruOrtho) tuile par tuile : ramène les cellules des sauts de hauteur flous du côté le plus proche, supprime les valeurs aberrantes (cellules qui s'écartent de plus que le seuil de la médiane pondérée par la confiance de leur fenêtre et ont trop peu de voisins à leur hauteur, de sorte que les bords et les angles des toits sont préservés), comble les trous jusqu'à une largeur maximale par interpolation harmonique (trous au pied des murs uniquement depuis le côté du sol ; les trous plus larges restent en NoData et sont signalés), et lisse en option les surfaces planes sans en estomper les arêtes. Dérive en option un modèle numérique de terrain (MNT) par un filtrage du sol de type SMRF, ainsi que le MNS normalisé (hauteur au-dessus du terrain). Les sorties conservent le SCR, la grille et le NoData de l'entrée ; les statistiques (valeurs aberrantes supprimées, cellules comblées, trous restants) sont renvoyées et journalisées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="302" />
+            <location filename="../processing/help/__init__.py" line="297" />
             <source>Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.</source>
             <translation>MNS brut : raster à une bande dans un SCR projeté (mètres) ; ses cellules NoData sont des trous.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="303" />
+            <location filename="../processing/help/__init__.py" line="298" />
             <source>Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum confidence are removed, less confident cells must agree better with their neighbours, and the median is weighted by confidence.</source>
             <translation>Raster de confiance facultatif dans [0, 1] (CONFIDENCE d'OSGM) : les cellules sous la confiance minimale sont supprimées, les cellules moins fiables doivent mieux concorder avec leurs voisines, et la médiane est pondérée par la confiance.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="306" />
+            <location filename="../processing/help/__init__.py" line="301" />
             <source>Largest departure from the neighbourhood median, metres (empty: 4 x the resolution).</source>
             <translation>Écart maximal à la médiane du voisinage, en mètres (vide : 4 x la résolution).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="308" />
+            <location filename="../processing/help/__init__.py" line="303" />
             <source>Side of the median window in cells (odd); a second pass uses twice the window.</source>
             <translation>Côté de la fenêtre médiane en cellules (impair) ; une seconde passe utilise une fenêtre deux fois plus grande.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="310" />
+            <location filename="../processing/help/__init__.py" line="305" />
             <source>Neighbours within the threshold of a cell's height that keep it although it departs from the median (edges, corners, thin structures).</source>
             <translation>Voisins à moins du seuil de la hauteur d'une cellule qui la conservent bien qu'elle s'écarte de la médiane (arêtes, angles, structures fines).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="312" />
+            <location filename="../processing/help/__init__.py" line="307" />
             <source>With a confidence raster: cells below this confidence are removed.</source>
             <translation>Avec un raster de confiance : les cellules sous cette confiance sont supprimées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="313" />
+            <location filename="../processing/help/__init__.py" line="308" />
             <source>With a confidence raster: less confident cells are removed when they depart by more than the threshold from the median of the cells at least this confident in their 15 x 15 window (0: off).</source>
             <translation>Avec un raster de confiance : les cellules moins fiables sont supprimées lorsqu'elles s'écartent de plus que le seuil de la médiane des cellules ayant au moins cette confiance dans leur fenêtre de 15 x 15 (0 : désactivé).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="316" />
+            <location filename="../processing/help/__init__.py" line="311" />
             <source>Largest hole width (metres) that is interpolated; 0 fills nothing.</source>
             <translation>Largeur maximale de trou (mètres) interpolée ; 0 ne comble rien.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="317" />
+            <location filename="../processing/help/__init__.py" line="312" />
             <source>Height difference between two surfaces (a wall), metres: hole boundary cells that much above nearby boundary cells are not interpolated from.</source>
             <translation>Différence de hauteur entre deux surfaces (un mur), en mètres : les cellules du bord d'un trou situées d'autant plus haut que les cellules de bord voisines ne servent pas à l'interpolation.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="319" />
+            <location filename="../processing/help/__init__.py" line="314" />
             <source>Snap the cells of blurred height steps (between the two levels of their 5 x 5 window) to the nearer level.</source>
             <translation>Ramener les cellules des sauts de hauteur flous (entre les deux niveaux de leur fenêtre de 5 x 5) au niveau le plus proche.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="321" />
+            <location filename="../processing/help/__init__.py" line="316" />
             <source>Replace cells by a local plane fitted to the neighbours at their height (flat and pitched roofs, streets); steps stay sharp.</source>
             <translation>Remplacer les cellules par un plan local ajusté aux voisines à leur hauteur (toits plats et en pente, rues) ; les sauts restent nets.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="323" />
+            <location filename="../processing/help/__init__.py" line="318" />
             <source>Radius of the smoothing neighbourhood, cells.</source>
             <translation>Rayon du voisinage de lissage, en cellules.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="324" />
+            <location filename="../processing/help/__init__.py" line="319" />
             <source>Neighbours within this height of a cell belong to its surface, metres (empty: 2.5 x the resolution).</source>
             <translation>Les voisines à moins de cette hauteur d'une cellule appartiennent à sa surface, en mètres (vide : 2,5 x la résolution).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="326" />
+            <location filename="../processing/help/__init__.py" line="321" />
             <source>Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); the DTM is written on the DSM grid.</source>
             <translation>Taille de cellule du filtre de sol, en mètres (vide : max(1 m, résolution du MNS)) ; le MNT est écrit sur la grille du MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="328" />
+            <location filename="../processing/help/__init__.py" line="323" />
             <source>Largest opening radius of the ground filter, metres: more than half the width of the largest building.</source>
             <translation>Rayon d'ouverture maximal du filtre de sol, en mètres : plus de la moitié de la largeur du plus grand bâtiment.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="330" />
+            <location filename="../processing/help/__init__.py" line="325" />
             <source>Terrain slope (rise over run) the ground filter keeps as ground.</source>
             <translation>Pente du terrain (dénivelé sur distance) que le filtre de sol conserve comme sol.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="331" />
+            <location filename="../processing/help/__init__.py" line="326" />
             <source>Where the tiles are filtered; the filtered DSM and the statistics are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The terrain model is computed in QGIS's process.</source>
             <translation>Où les tuiles sont filtrées ; le MNS filtré et les statistiques sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, une tuile après l'autre sur tous les cœurs (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire le MNS et le raster de confiance aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. Le modèle de terrain est calculé dans le processus de QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="344" />
+            <location filename="../processing/help/__init__.py" line="334" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>MNS filtré (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="345" />
+            <location filename="../processing/help/__init__.py" line="335" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Modèle numérique de terrain facultatif (GeoTIFF, float32, grille du MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="346" />
+            <location filename="../processing/help/__init__.py" line="336" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>MNS normalisé facultatif : MNS moins MNT, hauteurs au-dessus du terrain.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="347" />
+            <location filename="../processing/help/__init__.py" line="337" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON : les statistiques du filtre (et celles du filtre de sol).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="348" />
+            <location filename="../processing/help/__init__.py" line="338" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Cellules supprimées comme valeurs aberrantes ou pour confiance insuffisante.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="349" />
+            <location filename="../processing/help/__init__.py" line="339" />
             <source>Hole cells interpolated.</source>
             <translation>Cellules de trous interpolées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="350" />
+            <location filename="../processing/help/__init__.py" line="340" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Trous plus larges que MAX_HOLE, laissés en NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="355" />
+            <location filename="../processing/help/__init__.py" line="345" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Construit un maillage triangulaire. À partir d'un MNS : un maillage 2,5D dont les sauts de hauteur sont des murs verticaux (aucun triangle n'enjambe jamais un saut) et dont les zones planes et lisses sont décimées par un quadtree restreint avec une borne garantie de l'erreur verticale au centre de chaque cellule ; couleurs des sommets issues d'une orthoimage facultative. À partir d'un nuage de points (LAS/LAZ ou EPT, par ex. l'appariement fusionné d'images obliques) : un maillage de Delaunay 2,5D par système de référence, vu selon sa direction de visée (couches superposées là où des systèmes voient la même surface ; non étanche). Écrit du PLY (binaire) ou de l'OBJ, dans le SCR ou dans un repère local dont le décalage est consigné dans l'en-tête ; truortho:trueortho le lit comme SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="364" />
+            <location filename="../processing/help/__init__.py" line="354" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>Raster MNS (SCR projeté) ou nuage de points (.las, .laz, ou un ept.json EPT).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="365" />
+            <location filename="../processing/help/__init__.py" line="355" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Orthoimage facultative (RVB) pour les couleurs des sommets d'un maillage de MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="366" />
+            <location filename="../processing/help/__init__.py" line="356" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Écart vertical maximal entre le maillage et le MNS en tout centre de cellule, en mètres (vide : la moitié de la résolution du MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="368" />
+            <location filename="../processing/help/__init__.py" line="358" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Plus petite différence de hauteur entre cellules voisines qui devient un mur, en mètres.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="369" />
+            <location filename="../processing/help/__init__.py" line="359" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Pente la plus forte conservée en triangles inclinés, en degrés : le seuil de saut vaut max(MIN_STEP, résolution x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="371" />
+            <location filename="../processing/help/__init__.py" line="361" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Plus grand bloc de cellules qu'une paire de triangles peut couvrir (une puissance de deux).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="372" />
+            <location filename="../processing/help/__init__.py" line="362" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Nuages de points : arête de triangle la plus longue, en mètres (vide : 4 x l'espacement médian des points).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="373" />
+            <location filename="../processing/help/__init__.py" line="363" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>SCR : coordonnées terrain (doubles PLY). Local : terrain moins un décalage consigné sous la forme 'comment offset E N H' (PLY) ou '# offset E N H' (OBJ), pour les visionneuses qui ont besoin de petits nombres.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="375" />
+            <location filename="../processing/help/__init__.py" line="365" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Le maillage : .ply (binaire petit-boutiste, 'comment crs ...') ou .obj ('# crs ...', couleurs des sommets sous la forme 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="377" />
+            <location filename="../processing/help/__init__.py" line="367" />
             <source>Number of vertices.</source>
             <translation>Nombre de sommets.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="378" />
+            <location filename="../processing/help/__init__.py" line="368" />
             <source>Number of triangles.</source>
             <translation>Nombre de triangles.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="379" />
+            <location filename="../processing/help/__init__.py" line="369" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Nombre de triangles de murs verticaux (maillages de MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="384" />
+            <location filename="../processing/help/__init__.py" line="374" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (Layer &gt; Add Layer &gt; Point Cloud, choose ept.json).</source>
             <translation>Exporte un MNS en nuage de points, un point par centre de cellule valide, avec les couleurs d'une orthoimage et une confiance par point issue d'un raster de confiance : LAS 1.4 ou LAZ (format de point 7, SCR en WKT, dimensions supplémentaires 'confidence' et 'system' (le système de référence), un VLR TruOrtho décrivant les systèmes de référence), lisible par PDAL, laspy, LAStools et CloudCompare. Un jeu de données Entwine Point Tile (EPT) est écrit à côté : les versions de QGIS sans PDAL (comme le QGIS 3.22 de Debian) l'ouvrent comme couche nuage de points (Couche &gt; Ajouter une couche &gt; Nuage de points, choisir ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="392" />
+            <location filename="../processing/help/__init__.py" line="382" />
             <source>DSM raster with a projected CRS.</source>
             <translation>Raster MNS dans un SCR projeté.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="393" />
+            <location filename="../processing/help/__init__.py" line="383" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Orthoimage facultative (RVB) pour les couleurs des points.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="394" />
+            <location filename="../processing/help/__init__.py" line="384" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Raster de confiance facultatif dans [0, 1], stocké comme dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="395" />
+            <location filename="../processing/help/__init__.py" line="385" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Le nuage de points (.laz compressé, ou .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="396" />
+            <location filename="../processing/help/__init__.py" line="386" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Dossier du jeu de données EPT (ept.json, ept-data/, ept-hierarchy/) ; laisser vide pour ne pas l'écrire.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="397" />
+            <location filename="../processing/help/__init__.py" line="387" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Chemin du fichier ept.json du jeu de données EPT.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="398" />
+            <location filename="../processing/help/__init__.py" line="388" />
             <source>Number of points written.</source>
             <translation>Nombre de points écrits.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="403" />
+            <location filename="../processing/help/__init__.py" line="393" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Fusionne des nuages de points de plusieurs systèmes de référence (par ex. les systèmes nadir et obliques de l'appariement dense) en un seul fichier LAS 1.4 / LAZ, en conservant le 'system' de chaque point (les fichiers qui n'en ont pas reçoivent l'index de leur fichier) et sa confiance ; éclaircit en option les doublons sur une grille de voxels en gardant le point le plus fiable de chaque voxel ; écrit en option un jeu de données EPT pour QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="409" />
+            <location filename="../processing/help/__init__.py" line="399" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>Fichiers LAS/LAZ dans un même SCR.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="410" />
+            <location filename="../processing/help/__init__.py" line="400" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Taille des voxels pour l'éclaircissement, en mètres (vide : conserver tous les points).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="411" />
+            <location filename="../processing/help/__init__.py" line="401" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Le nuage de points fusionné (.laz ou .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="412" />
+            <location filename="../processing/help/__init__.py" line="402" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Dossier facultatif pour un jeu de données EPT du nuage fusionné.</translation>
         </message>

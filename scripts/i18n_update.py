@@ -74,6 +74,11 @@ def extract(root: Path = ROOT) -> dict[str, str]:
                         s = _literal(node.value)
                         if s:
                             add(s, f"{rel}:{node.lineno}")
+                    elif help_module and name and name.endswith("_HELP"):
+                        # shared help texts (e.g. _SCHEDULER_HELP) used by several HELP entries
+                        s = _literal(node.value)
+                        if s:
+                            add(s, f"{rel}:{node.lineno}")
                     elif name == "GROUPS" and isinstance(node.value, ast.Dict):
                         for v in node.value.values:
                             for s in _strings_in(v):

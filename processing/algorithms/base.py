@@ -2,7 +2,13 @@
 
 from __future__ import annotations
 
-from qgis.core import QgsProcessing, QgsProcessingAlgorithm, QgsProcessingParameterVectorLayer
+from qgis.core import (
+    QgsProcessing,
+    QgsProcessingAlgorithm,
+    QgsProcessingParameterEnum,
+    QgsProcessingParameterString,
+    QgsProcessingParameterVectorLayer,
+)
 
 from ..help import help_html, parameter_help
 from ..i18n import tr
@@ -49,6 +55,47 @@ class TruOrthoAlgorithm(QgsProcessingAlgorithm):
             param.setFlags(param.flags() | param.FlagAdvanced)
         self.addParameter(param)
         return param
+
+    #: Values of the EXECUTOR parameter (:func:`truortho.core.parallel.make_executor`).
+    EXECUTOR_CHOICES = ("inprocess", "local", "scheduler")
+
+    def add_executor(self) -> None:
+        """The advanced EXECUTOR and SCHEDULER_ADDRESS parameters of the tiled algorithms."""
+        import os
+
+        from ...core.parallel import SCHEDULER_ENV
+
+        self.add(
+            QgsProcessingParameterEnum(
+                "EXECUTOR",
+                tr("Run tiles on"),
+                options=[
+                    tr("inprocess: this process (all cores)"),
+                    tr("local: a Dask cluster of worker processes on this computer"),
+                    tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
+                ],
+                defaultValue=0,
+            ),
+            advanced=True,
+        )
+        self.add(
+            QgsProcessingParameterString(
+                "SCHEDULER_ADDRESS",
+                tr(
+                    "Dask scheduler address (tls://host:port or scheduler file; "
+                    "empty = TRUORTHO_DASK_SCHEDULER)"
+                ),
+                defaultValue=os.environ.get(SCHEDULER_ENV, ""),
+                optional=True,
+            ),
+            advanced=True,
+        )
+
+    def executor_choice(self, parameters, context) -> tuple[str, str | None]:
+        """(EXECUTOR name, SCHEDULER_ADDRESS or None) of a run."""
+        address = (self.parameterAsString(parameters, "SCHEDULER_ADDRESS", context) or "").strip()
+        kind = self.EXECUTOR_CHOICES[self.parameterAsEnum(parameters, "EXECUTOR", context)]
+        return kind, address or None
 
     def add_ground_control(self) -> None:
         """The optional GCPS point layer and OBSERVATIONS table (schema in docs/FORMATS.md)."""

@@ -9,11 +9,9 @@ from qgis.core import (
     QgsProcessingOutputNumber,
     QgsProcessingOutputString,
     QgsProcessingParameterBoolean,
-    QgsProcessingParameterEnum,
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterRasterLayer,
-    QgsProcessingParameterString,
 )
 
 from ..feedback import FeedbackProgress, core_errors
@@ -60,7 +58,6 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
     CELLS_FILLED = "CELLS_FILLED"
     HOLES_REMAINING = "HOLES_REMAINING"
 
-    EXECUTOR_CHOICES = ["inprocess", "local", "scheduler"]
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         num = QgsProcessingParameterNumber
@@ -153,33 +150,7 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
             num(self.SLOPE, tr("Ground filter slope (rise/run)"), num.Double, 0.15, minValue=0.001),
             advanced=True,
         )
-        self.add(
-            QgsProcessingParameterEnum(
-                self.EXECUTOR,
-                tr("Run tiles on"),
-                options=[
-                    tr("inprocess: this process (all cores)"),
-                    tr("local: a Dask cluster of worker processes on this computer"),
-                    tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
-                ],
-                defaultValue=0,
-            ),
-            advanced=True,
-        )
-        from ...core.parallel import SCHEDULER_ENV
-
-        self.add(
-            QgsProcessingParameterString(
-                self.SCHEDULER_ADDRESS,
-                tr(
-                    "Dask scheduler address (tls://host:port or scheduler file; "
-                    "empty = TRUORTHO_DASK_SCHEDULER)"
-                ),
-                defaultValue=os.environ.get(SCHEDULER_ENV, ""),
-                optional=True,
-            ),
-            advanced=True,
-        )
+        self.add_executor()
         self.add(QgsProcessingParameterRasterDestination(self.OUTPUT, tr("Filtered DSM")))
         self.add(
             QgsProcessingParameterRasterDestination(
@@ -223,9 +194,9 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
             smooth_radius=self.parameterAsInt(parameters, self.SMOOTH_RADIUS, context),
             smooth_tolerance=_optional_number(self, parameters, self.SMOOTH_TOLERANCE, context),
         )
-        address = (self.parameterAsString(parameters, self.SCHEDULER_ADDRESS, context) or "").strip()
+        executor_kind, address = self.executor_choice(parameters, context)
         executor = make_executor(
-            self.EXECUTOR_CHOICES[self.parameterAsEnum(parameters, self.EXECUTOR, context)], address or None
+            executor_kind, address
         )
         progress = FeedbackProgress(feedback)
         steps = Steps(progress, [3, 1 if (dtm or ndsm) else 0])

@@ -21,7 +21,6 @@ from qgis.core import (
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
     QgsProcessingParameterRasterLayer,
-    QgsProcessingParameterString,
 )
 
 from ..feedback import FeedbackProgress, core_errors
@@ -62,7 +61,6 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
 
     PATH_CHOICES = [8, 16]
     OBLIQUE_CHOICES = ["none", "auto"]
-    EXECUTOR_CHOICES = ["inprocess", "local", "scheduler"]
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         num = QgsProcessingParameterNumber
@@ -163,33 +161,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
             num(self.TILE_SIZE, tr("Tile size (cells)"), num.Integer, 256, minValue=32, maxValue=8192),
             advanced=True,
         )
-        self.add(
-            QgsProcessingParameterEnum(
-                self.EXECUTOR,
-                tr("Run tiles on"),
-                options=[
-                    tr("inprocess: this process (all cores)"),
-                    tr("local: a Dask cluster of worker processes on this computer"),
-                    tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
-                ],
-                defaultValue=0,
-            ),
-            advanced=True,
-        )
-        from ...core.parallel import SCHEDULER_ENV
-
-        self.add(
-            QgsProcessingParameterString(
-                self.SCHEDULER_ADDRESS,
-                tr(
-                    "Dask scheduler address (tls://host:port or scheduler file; "
-                    "empty = TRUORTHO_DASK_SCHEDULER)"
-                ),
-                defaultValue=os.environ.get(SCHEDULER_ENV, ""),
-                optional=True,
-            ),
-            advanced=True,
-        )
+        self.add_executor()
         self.add(QgsProcessingParameterRasterDestination(self.DSM, tr("DSM (OSGM)")))
         self.add(
             QgsProcessingParameterRasterDestination(
@@ -275,7 +247,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
 
         from ...core.osgm import OsgmConfig, OsgmOutputs, run_osgm
 
-        address = (self.parameterAsString(parameters, self.SCHEDULER_ADDRESS, context) or "").strip()
+        executor_kind, address = self.executor_choice(parameters, context)
 
         cfg = OsgmConfig(
             resolution=res or None,
@@ -288,8 +260,8 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
             max_images=self.parameterAsInt(parameters, self.MAX_IMAGES, context),
             oblique=self.OBLIQUE_CHOICES[self.parameterAsEnum(parameters, self.OBLIQUE, context)],
             tile_size=self.parameterAsInt(parameters, self.TILE_SIZE, context),
-            executor=self.EXECUTOR_CHOICES[self.parameterAsEnum(parameters, self.EXECUTOR, context)],
-            scheduler_address=address or None,
+            executor=executor_kind,
+            scheduler_address=address,
         )
         outputs = OsgmOutputs(dsm=dsm, confidence=confidence, orthoimage=ortho, point_cloud=cloud)
         cfg.validate()  # the core's checks (penalties, output types, ...), before the orientation is read

@@ -13,11 +13,9 @@ from qgis.core import (
     QgsProcessingOutputVectorLayer,
     QgsProcessingParameterBoolean,
     QgsProcessingParameterCrs,
-    QgsProcessingParameterEnum,
     QgsProcessingParameterFile,
     QgsProcessingParameterFolderDestination,
     QgsProcessingParameterNumber,
-    QgsProcessingParameterString,
 )
 
 from ..feedback import FeedbackProgress, core_errors
@@ -53,7 +51,6 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         "SEAMLINES": "seamlines",
     }
 
-    EXECUTOR_CHOICES = ["inprocess", "local", "scheduler"]
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
@@ -83,33 +80,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
                 self.REUSE_ORIENTATION, tr("Reuse an existing orientation.json in the output folder"), False
             )
         )
-        self.add(
-            QgsProcessingParameterEnum(
-                self.EXECUTOR,
-                tr("Run tiles on"),
-                options=[
-                    tr("inprocess: this process (all cores)"),
-                    tr("local: a Dask cluster of worker processes on this computer"),
-                    tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
-                ],
-                defaultValue=0,
-            ),
-            advanced=True,
-        )
-        from ...core.parallel import SCHEDULER_ENV
-
-        self.add(
-            QgsProcessingParameterString(
-                self.SCHEDULER_ADDRESS,
-                tr(
-                    "Dask scheduler address (tls://host:port or scheduler file; "
-                    "empty = TRUORTHO_DASK_SCHEDULER)"
-                ),
-                defaultValue=os.environ.get(SCHEDULER_ENV, ""),
-                optional=True,
-            ),
-            advanced=True,
-        )
+        self.add_executor()
         self.add(QgsProcessingParameterFolderDestination(self.OUTPUT_FOLDER, tr("Output folder")))
         names = {
             "ORIENTATION": tr("Orientation (JSON)"),
@@ -160,14 +131,14 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         res = self.parameterAsDouble(parameters, self.RESOLUTION, context)
         if res < 0:
             raise QgsProcessingException(tr("RESOLUTION: expected a positive number of metres or 0"))
-        address = (self.parameterAsString(parameters, self.SCHEDULER_ADDRESS, context) or "").strip()
+        executor_kind, address = self.executor_choice(parameters, context)
         cfg = WorkflowConfig(
             resolution=res if res > 0 else None,
             camera_file=self.parameterAsFile(parameters, self.CAMERA, context) or None,
             reuse_orientation=reuse,
             # one executor for OSGM, the DSM filter and the true orthophoto (made and closed by run_workflow)
-            executor=self.EXECUTOR_CHOICES[self.parameterAsEnum(parameters, self.EXECUTOR, context)],
-            scheduler_address=address or None,
+            executor=executor_kind,
+            scheduler_address=address,
         )
         run = run_workflow(
             images,

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import os
-
 from qgis.core import (
     QgsFeature,
     QgsFeatureSink,
@@ -14,13 +12,11 @@ from qgis.core import (
     QgsProcessingException,
     QgsProcessingParameterBoolean,
     QgsProcessingParameterCrs,
-    QgsProcessingParameterEnum,
     QgsProcessingParameterExtent,
     QgsProcessingParameterFeatureSink,
     QgsProcessingParameterFile,
     QgsProcessingParameterNumber,
     QgsProcessingParameterRasterDestination,
-    QgsProcessingParameterString,
     QgsWkbTypes,
 )
 from qgis.PyQt.QtCore import QVariant
@@ -61,7 +57,6 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     OCCLUSION = "OCCLUSION"
     SEAMLINES = "SEAMLINES"
 
-    EXECUTOR_CHOICES = ["inprocess", "local", "scheduler"]
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
@@ -121,33 +116,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             ),
             advanced=True,
         )
-        self.add(
-            QgsProcessingParameterEnum(
-                self.EXECUTOR,
-                tr("Run tiles on"),
-                options=[
-                    tr("inprocess: this process (all cores)"),
-                    tr("local: a Dask cluster of worker processes on this computer"),
-                    tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
-                ],
-                defaultValue=0,
-            ),
-            advanced=True,
-        )
-        from ...core.parallel import SCHEDULER_ENV
-
-        self.add(
-            QgsProcessingParameterString(
-                self.SCHEDULER_ADDRESS,
-                tr(
-                    "Dask scheduler address (tls://host:port or scheduler file; "
-                    "empty = TRUORTHO_DASK_SCHEDULER)"
-                ),
-                defaultValue=os.environ.get(SCHEDULER_ENV, ""),
-                optional=True,
-            ),
-            advanced=True,
-        )
+        self.add_executor()
         self.add(QgsProcessingParameterRasterDestination(self.OUTPUT, tr("True orthophoto")))
         self.add(
             QgsProcessingParameterRasterDestination(
@@ -187,7 +156,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             if not r.isNull() and r.width() > 0 and r.height() > 0:
                 extent = (r.xMinimum(), r.yMinimum(), r.xMaximum(), r.yMaximum())
         res = self.parameterAsDouble(parameters, self.RESOLUTION, context)
-        address = (self.parameterAsString(parameters, self.SCHEDULER_ADDRESS, context) or "").strip()
+        executor_kind, address = self.executor_choice(parameters, context)
         cfg = TrueOrthoConfig(
             resolution=res if res > 0 else None,
             extent=extent,
@@ -197,8 +166,8 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             blend_width=self.parameterAsInt(parameters, self.BLEND_WIDTH, context),
             tile_size=self.parameterAsInt(parameters, self.TILE_SIZE, context),
             # true_ortho makes the executor from these and closes it at the end
-            executor=self.EXECUTOR_CHOICES[self.parameterAsEnum(parameters, self.EXECUTOR, context)],
-            scheduler_address=address or None,
+            executor=executor_kind,
+            scheduler_address=address,
         )
         out = self.parameterAsOutputLayer(parameters, self.OUTPUT, context)
         idx = self.parameterAsOutputLayer(parameters, self.SOURCE_INDEX, context) or None

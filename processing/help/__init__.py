@@ -10,6 +10,16 @@ from html import escape
 
 from ..i18n import tr
 
+#: Help of SCHEDULER_ADDRESS, the same for every tiled algorithm.
+_SCHEDULER_HELP = (
+    "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
+    "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
+    "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
+    "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
+    "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
+    "that is not on this computer is refused."
+)
+
 HELP: dict[str, dict] = {
     "importorientation": {
         "summary": (
@@ -142,12 +152,7 @@ HELP: dict[str, dict] = {
             "dies has its tiles recomputed by the others. The orientation, the mesh and the report are "
             "computed in QGIS's process. The address is checked before the orientation starts; the scheduler "
             "is first contacted by dense matching.",
-            "SCHEDULER_ADDRESS": "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
-            "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
-            "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
-            "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
-            "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
-            "that is not on this computer is refused.",
+            "SCHEDULER_ADDRESS": _SCHEDULER_HELP,
             "OUTPUT_FOLDER": "Folder of the products (created when missing; existing products are replaced).",
             "ORIENTATION": "orientation.json: the adjusted orientation.",
             "REPORT": "report.html (and report.json): the quality report of the run.",
@@ -213,12 +218,7 @@ HELP: dict[str, dict] = {
             "have TruOrtho installed. A worker that dies has its tiles recomputed by the others. "
             "Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with "
             "the same inputs and parameters after a crash reuses them.",
-            "SCHEDULER_ADDRESS": "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
-            "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
-            "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
-            "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
-            "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
-            "that is not on this computer is refused.",
+            "SCHEDULER_ADDRESS": _SCHEDULER_HELP,
             "DSM": "The raw DSM: GeoTIFF, float32, in the orientation's CRS, nodata -9999.",
             "CONFIDENCE": "Optional confidence GeoTIFF (float32 in [0, 1], nodata -1) on the DSM grid, for "
             "truortho:dsmfilter.",
@@ -270,12 +270,7 @@ HELP: dict[str, dict] = {
             "estimated in QGIS's process. Finished tiles are kept in a folder beside the output (its name "
             "plus '.tiles') until the run succeeds, so a rerun with the same inputs and parameters after a "
             "crash reuses them.",
-            "SCHEDULER_ADDRESS": "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
-            "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
-            "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
-            "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
-            "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
-            "that is not on this computer is refused.",
+            "SCHEDULER_ADDRESS": _SCHEDULER_HELP,
             "OUTPUT": "GeoTIFF with the images' bands and data type plus an alpha band, tiled, with "
             "overviews, Cloud-Optimized GeoTIFF layout.",
             "SOURCE_INDEX": "Int16 GeoTIFF: index (0-based, orientation order) of the image each cell "
@@ -335,12 +330,7 @@ HELP: dict[str, dict] = {
             "by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same "
             "paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles "
             "recomputed by the others. The terrain model is computed in QGIS's process.",
-            "SCHEDULER_ADDRESS": "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
-            "or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. "
-            "Security: a Dask scheduler executes any code its clients send, so it must never be reachable "
-            "unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's "
-            "configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address "
-            "that is not on this computer is refused.",
+            "SCHEDULER_ADDRESS": _SCHEDULER_HELP,
             "OUTPUT": "Filtered DSM (GeoTIFF, float32).",
             "DTM": "Optional terrain model (GeoTIFF, float32, DSM grid).",
             "NDSM": "Optional normalised DSM: DSM minus DTM, heights above the terrain.",
