@@ -40,13 +40,12 @@ candidates and RGB: 16 x 538^2 x 38 B = 176 MB.
 from __future__ import annotations
 
 import os
-from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..grid import RasterGrid, Tile
-from ..parallel import Digest, current_cancel, tune_worker_malloc
+from ..parallel import Digest, ProcessLRU, current_cancel, tune_worker_malloc
 from .color import ColorCorrection
 from .mosaic import ImageStore, MosaicParams, mosaic_tile, to_dtype
 from .surface import PlanTransform
@@ -92,24 +91,17 @@ class OrthoTask:
         return Digest(base, "ortho-tile", list(self.tile.outer), list(self.tile.core), self.fixed).hexdigest()
 
 
-_STORES: OrderedDict = OrderedDict()
-_MAX_STORES = 2
+_STORES = ProcessLRU(2)
 
 
 def worker_store(ctx: OrthoContext) -> ImageStore:
     """The run's image store in this process, else this worker process's own (LRU of two)."""
     if ctx.store is not None:
         return ctx.store
-    k = ctx.store_key()
-    st = _STORES.get(k)
-    if st is None:
-        st = ImageStore(list(ctx.paths), list(ctx.sizes), ctx.bands, np.dtype(ctx.dtype), ctx.cache_bytes)
-        _STORES[k] = st
-        while len(_STORES) > _MAX_STORES:
-            _STORES.popitem(last=False)
-    else:
-        _STORES.move_to_end(k)
-    return st
+    return _STORES.get(
+        ctx.store_key(),
+        lambda: ImageStore(list(ctx.paths), list(ctx.sizes), ctx.bands, np.dtype(ctx.dtype), ctx.cache_bytes),
+    )
 
 
 def _threads(ctx: OrthoContext) -> int:

@@ -30,12 +30,11 @@ its decoded images (``cache_bytes``).
 from __future__ import annotations
 
 import dataclasses
-from collections import OrderedDict
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..parallel import Digest, current_cancel, file_identity, tune_worker_malloc
+from ..parallel import Digest, ProcessLRU, current_cancel, file_identity, tune_worker_malloc
 from .matching import TileParams, View, match_tile
 from .views import ImagePyramid
 
@@ -124,24 +123,16 @@ class TileTask:
         ).hexdigest()
 
 
-_PYRAMIDS: OrderedDict = OrderedDict()
-_MAX_PYRAMIDS = 2
+_PYRAMIDS = ProcessLRU(2)
 
 
 def worker_pyramid(ctx: TileContext) -> ImagePyramid:
     """The run's pyramid in this process, else this worker process's own (LRU of two)."""
     if ctx.pyramid is not None:
         return ctx.pyramid
-    k = ctx.pyramid_key()
-    pyr = _PYRAMIDS.get(k)
-    if pyr is None:
-        pyr = ImagePyramid(list(ctx.paths), list(ctx.sizes), ctx.band, ctx.cache_bytes)
-        _PYRAMIDS[k] = pyr
-        while len(_PYRAMIDS) > _MAX_PYRAMIDS:
-            _PYRAMIDS.popitem(last=False)
-    else:
-        _PYRAMIDS.move_to_end(k)
-    return pyr
+    return _PYRAMIDS.get(
+        ctx.pyramid_key(), lambda: ImagePyramid(list(ctx.paths), list(ctx.sizes), ctx.band, ctx.cache_bytes)
+    )
 
 
 def osgm_tile_task(ctx: TileContext, task: TileTask) -> tuple[np.ndarray, np.ndarray]:

@@ -4,7 +4,7 @@ See :mod:`.executors` for the backends, security and fault tolerance, and
 :mod:`.cache` for the content-addressed tile cache.
 """
 
-from .cache import CACHE_FORMAT, Digest, TileCache, file_identity
+from .cache import CACHE_FORMAT, Digest, ProcessLRU, TileCache, file_identity
 from .executors import (
     EXECUTORS,
     SCHEDULER_ENV,
@@ -26,6 +26,7 @@ __all__ = [
     "Digest",
     "Executor",
     "InProcessExecutor",
+    "ProcessLRU",
     "LocalDaskExecutor",
     "SchedulerExecutor",
     "TileCache",

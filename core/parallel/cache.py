@@ -125,3 +125,27 @@ class TileCache:
         """Remove the folder when it was only this run's scratch space (``remove_when_done``)."""
         if self.remove_when_done:
             shutil.rmtree(self.folder, ignore_errors=True)
+
+
+class ProcessLRU:
+    """Objects a worker process keeps between tasks (decoded images, pyramids), by key, LRU.
+
+    ``get(key, make)`` returns the object of ``key``, made by ``make()`` on a miss; at most
+    ``size`` objects are kept. Module-level instances live as long as the worker process.
+    """
+
+    def __init__(self, size: int = 2) -> None:
+        from collections import OrderedDict
+
+        self.size = max(1, int(size))
+        self._items: OrderedDict = OrderedDict()
+
+    def get(self, key, make):
+        obj = self._items.get(key)
+        if obj is None:
+            obj = self._items[key] = make()
+            while len(self._items) > self.size:
+                self._items.popitem(last=False)
+        else:
+            self._items.move_to_end(key)
+        return obj
