@@ -30,10 +30,17 @@ from .views import TileViews
 
 
 class ImageStore:
-    """Decoded images by (index, level) with an LRU cache of at most ``max_bytes``."""
+    """Decoded images by (index, level) with an LRU cache of at most ``max_bytes``; rasters that
+    rasterio reads (GeoTIFF) are read by windows instead (:meth:`source`)."""
 
     def __init__(
-        self, paths: list[str], sizes: list[tuple[int, int]], bands: int, dtype, max_bytes: int = 1 << 30
+        self,
+        paths: list[str],
+        sizes: list[tuple[int, int]],
+        bands: int,
+        dtype,
+        max_bytes: int = 1 << 30,
+        windowed: bool = True,
     ) -> None:
         self.paths = paths
         self.sizes = sizes
@@ -42,7 +49,12 @@ class ImageStore:
         self.max_bytes = int(max_bytes)
         self._cache: OrderedDict = OrderedDict()
         self._bytes = 0
-        self.reads = 0
+        self.reads = 0  # whole images decoded
+        self.window_reads = 0
+        from ..imagery import _use_rasterio
+
+        #: read by windows (rasterio formats) instead of decoded whole
+        self.windowed = [bool(windowed) and _use_rasterio(str(p)) for p in paths]
         import threading
 
         self._lock = threading.RLock()
@@ -103,6 +115,75 @@ class ImageStore:
             self._bytes -= old.nbytes
         return img
 
+    def level_size(self, i: int, level: int) -> tuple[int, int]:
+        """(width, height) of image ``i`` at ``level`` (halvings rounded up)."""
+        w, h = self.sizes[i]
+        for _ in range(level):
+            w, h = max(1, (w + 1) // 2), max(1, (h + 1) // 2)
+        return w, h
+
+    def source(self, i: int, level: int, uv: np.ndarray):
+        """What to sample the full-resolution points ``uv`` (n, 2) from at ``level``.
+
+        ``(array, (x0, y0), (w', h'))``: the whole decoded level image (JPEG, PNG: decoded once,
+        cached) or, for rasters that can be read by windows (GeoTIFF: tiled, with overviews if
+        any), only the window the points need plus 2 pixels, read for this call (not cached):
+        a tile task then reads the windows it needs, not the images.
+        """
+        lw, lh = self.level_size(i, level)
+        if not self.windowed[i] or not len(uv):
+            img = self.get(i, level)
+            return img, (0, 0), (img.shape[1], img.shape[0])
+        W, H = self.sizes[i]
+        u = (uv[:, 0].astype(np.float64) + 0.5) * lw / W - 0.5
+        v = (uv[:, 1].astype(np.float64) + 0.5) * lh / H - 0.5
+        ok = np.isfinite(u) & np.isfinite(v)
+        if not ok.any():
+            img = self.get(i, level)
+            return img, (0, 0), (img.shape[1], img.shape[0])
+        x0 = max(int(np.floor(u[ok].min())) - 2, 0)
+        y0 = max(int(np.floor(v[ok].min())) - 2, 0)
+        x1 = min(int(np.ceil(u[ok].max())) + 3, lw)
+        y1 = min(int(np.ceil(v[ok].max())) + 3, lh)
+        if x1 <= x0 or y1 <= y0:
+            x0, y0, x1, y1 = 0, 0, min(lw, 1), min(lh, 1)
+        return self._read_window(i, level, x0, y0, x1 - x0, y1 - y0), (x0, y0), (lw, lh)
+
+    def _read_window(self, i: int, level: int, x0: int, y0: int, w: int, h: int) -> np.ndarray:
+        """Window of level ``level`` read through rasterio (decimated by averaging; overviews used)."""
+        import warnings
+
+        import rasterio
+        from rasterio.enums import Resampling
+        from rasterio.windows import Window
+
+        f = 2**level
+        W, H = self.sizes[i]
+        fx0, fy0 = x0 * f, y0 * f
+        fw, fh = min(w * f, W - fx0), min(h * f, H - fy0)
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", rasterio.errors.NotGeoreferencedWarning)
+                with rasterio.open(self.paths[i]) as ds:
+                    if (ds.width, ds.height) != (W, H) or ds.count != self.bands:
+                        raise FormatError(
+                            self.paths[i],
+                            f"image is {ds.width} x {ds.height} with {ds.count} band(s), expected "
+                            f"{W} x {H} with {self.bands}",
+                        )
+                    data = ds.read(
+                        window=Window(fx0, fy0, fw, fh),
+                        out_shape=(ds.count, h, w) if level else None,
+                        resampling=Resampling.average,
+                    )
+        except rasterio.errors.RasterioIOError as exc:
+            raise FormatError(self.paths[i], f"not a readable image ({exc})") from None
+        if data.dtype != self.dtype:
+            raise FormatError(self.paths[i], f"image is {data.dtype}, the block {self.dtype}")
+        self.window_reads += 1
+        img = data[0] if data.shape[0] == 1 else np.moveaxis(data, 0, -1)
+        return np.ascontiguousarray(img)
+
     def level_for(self, gsd: float, res: float) -> int:
         """Level whose pixel (``gsd * 2**level``) is at most the output cell ``res``."""
         if not (gsd > 0 and res > 0):
@@ -110,19 +191,27 @@ class ImageStore:
         return max(0, min(8, int(math.floor(math.log2(res / gsd) + 1e-9))))
 
 
-def sample(img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, int]) -> np.ndarray:
+def sample(
+    img: np.ndarray,
+    uv: np.ndarray,
+    level: int,
+    full_size: tuple[int, int],
+    origin: tuple[int, int] = (0, 0),
+    level_size: tuple[int, int] | None = None,
+) -> np.ndarray:
     """Bilinear samples ``(rows, cols, bands)`` float32 at full-resolution pixel coordinates ``uv``.
 
     ``uv``: (rows, cols, 2) float32, NaN where not needed (sampled as 0).
-    At ``level`` > 0 coordinates map as ``x' = (x + 0.5) * w'/w - 0.5``.
+    At ``level`` > 0 coordinates map as ``x' = (x + 0.5) * w'/w - 0.5``. ``img`` may be a window
+    of the level image: ``origin`` its first pixel (x, y), ``level_size`` the level's (w', h').
     """
     import cv2
 
-    h, w = img.shape[:2]
+    h, w = img.shape[:2] if level_size is None else (level_size[1], level_size[0])
     W, H = full_size
     sx, sy = w / W, h / H
-    mx = ((uv[..., 0] + 0.5) * sx - 0.5).astype(np.float32)
-    my = ((uv[..., 1] + 0.5) * sy - 0.5).astype(np.float32)
+    mx = ((uv[..., 0] + 0.5) * sx - 0.5 - origin[0]).astype(np.float32)
+    my = ((uv[..., 1] + 0.5) * sy - 0.5 - origin[1]).astype(np.float32)
     bad = ~(np.isfinite(mx) & np.isfinite(my))
     mx[bad] = -10.0
     my[bad] = -10.0
@@ -141,14 +230,16 @@ def sample(img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, in
     return np.concatenate(outs, axis=2) if len(outs) > 1 else outs[0]
 
 
-def sample_points(img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, int]) -> np.ndarray:
+def sample_points(
+    img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, int], **kw
+) -> np.ndarray:
     """:func:`sample` of ``(n, 2)`` points: ``(n, bands)`` float32 (OpenCV maps are at most 32767 wide)."""
     n = len(uv)
     width = 1024
     rows = max(1, -(-n // width))
     pad = np.full((rows * width, 2), np.nan, np.float32)
     pad[:n] = uv
-    out = sample(img, pad.reshape(rows, width, 2), level, full_size)
+    out = sample(img, pad.reshape(rows, width, 2), level, full_size, **kw)
     return out.reshape(rows * width, -1)[:n]
 
 
@@ -220,14 +311,15 @@ def candidate_colours(
             continue
         i = int(views.cands[k])
         level = store.level_for(float(views.gsd[k]), res)
-        img = store.get(i, level)
+        img, origin, lsize = store.source(i, level, views.uv[k][m])
+        kw = {"origin": origin, "level_size": lsize}
         if m.sum() * 4 < m.size:  # few cells (a late candidate): sample only those
-            col = sample_points(img, views.uv[k][m], level, store.sizes[i])
+            col = sample_points(img, views.uv[k][m], level, store.sizes[i], **kw)
             if correction is not None and not correction.is_identity(i):
                 col = correction.apply(i, col, store.dtype).astype(np.float32)
             out[k][m] = col
             continue
-        col = sample(img, views.uv[k], level, store.sizes[i])
+        col = sample(img, views.uv[k], level, store.sizes[i], **kw)
         if correction is not None and not correction.is_identity(i):
             out[k][m] = correction.apply(i, col[m], store.dtype).astype(np.float32)
         else:

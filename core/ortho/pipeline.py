@@ -588,6 +588,7 @@ def true_ortho(
             "coverage": round(n_seen / n_valid, 6) if n_valid else 0.0,
             "images_used": int(np.count_nonzero(counts)),
             "image_reads": store.reads,
+            "image_window_reads": store.window_reads,
             "max_triangles_per_tile": int(tri_max),
             "cell_image_samples": n_samples,
             "seconds_total": round(time.perf_counter() - t_start, 3),
