@@ -262,7 +262,8 @@ HELP: dict[str, dict] = {
             "TILE_SIZE": "Tile side in cells; memory grows with its square and the images per tile.",
             "EXECUTOR": "Where the tiles of the mosaic are computed; the true orthophoto, source index, "
             "occlusion mask and seamlines are identical with every choice. inprocess: in QGIS's process, "
-            "one tile after the other (the default). local: a Dask cluster of worker processes on this "
+            "the independent tiles of a wave in parallel threads (the default). local: a Dask cluster of "
+            "worker processes on this "
             "computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: "
             "an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images and the "
             "surface at the same paths (shared storage) and have TruOrtho installed. A worker that dies "
