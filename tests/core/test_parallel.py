@@ -249,6 +249,22 @@ def test_in_process_executor_keeps_task_order_caches_and_cancels(tmp_path):
     assert calls == [1]
 
 
+@pytest.mark.slow
+def test_local_cluster_listens_on_loopback_only(cluster):
+    """Every listening socket of the local cluster (scheduler and nannies in this process, the
+    worker processes) is bound to 127.0.0.1: nothing is reachable from another machine."""
+    import psutil
+
+    pids = [os.getpid(), *cluster.worker_pids().values()]
+    def conns(pid):
+        p = psutil.Process(pid)
+        return (getattr(p, "net_connections", None) or p.connections)(kind="inet")  # psutil < 6
+
+    listening = [c.laddr for pid in pids for c in conns(pid) if c.status == psutil.CONN_LISTEN]
+    assert len(listening) >= 3  # scheduler + a worker each at least
+    assert all(a.ip == "127.0.0.1" for a in listening), listening
+
+
 def test_in_process_threads_keep_task_order_and_stop_on_cancel():
     import threading
 
