@@ -96,6 +96,35 @@ def test_separate_scheduler_gives_the_in_process_orthophoto(scene, reference, da
 
 
 @pytest.mark.slow
+def test_reprojected_output_and_mesh_surface_on_the_cluster(scene, dask_cluster, tmp_path):
+    """Another output CRS (pyproj rebuilt on the workers) and a mesh surface (arrays shipped to the
+    workers): the cluster gives the in-process result."""
+    from truortho.core.ortho.surface import MeshSurface, transform_bounds
+    from truortho.core.ortho.zbuffer import dsm_triangles
+
+    sc, folder = scene
+    ext = sc.extent_world()
+    crs = sc.config.crs
+    b = transform_bounds((ext[0] + 5, ext[1] + 5, ext[2] - 5, ext[3] - 5), crs, "EPSG:32633")
+    h, gt = sc.dsm(RES)
+    tris = dsm_triangles(h, gt[0], gt[3], RES)
+    mesh = MeshSurface(tris.vertices, tris.faces, crs)
+    for name, surface, cfg in (
+        ("utm33", folder / "dsm.tif", dict(crs="EPSG:32633", extent=b)),
+        ("mesh", mesh, dict(extent=ext)),
+    ):
+        runs = {}
+        for where, ex in (("in", None), ("dask", dask_cluster)):
+            out = tmp_path / f"{name}_{where}.tif"
+            config = TrueOrthoConfig(resolution=RES, tile_size=TILE, color_correction=False, **cfg)
+            r = true_ortho(folder / "orientation.json", surface, out, config=config, executor=ex)
+            runs[where] = read_raster(out, band=None)[0]
+        assert r.stats["tiles"] >= 4 and (name != "utm33" or r.stats["reprojected"])
+        assert np.array_equal(runs["in"], runs["dask"]), name
+        assert (runs["in"][-1] > 0).mean() > 0.9
+
+
+@pytest.mark.slow
 def test_a_worker_killed_mid_run_changes_nothing(scene, reference, dask_cluster, tmp_path):
     pids = dask_cluster.worker_pids()
     killed = []
