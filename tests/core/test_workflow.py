@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from truortho.core.errors import InputError
+from truortho.core.osgm import OsgmConfig
 from truortho.core.progress import CallbackProgress
 from truortho.core.rasterio_io import read_raster
 from truortho.core.synthetic import SceneConfig, make_scene
@@ -60,6 +61,36 @@ def test_workflow_products_and_report_from_a_reused_orientation(tmp_path):
 
     ds = ogr.Open(str(out / "seamlines.gpkg"))
     assert ds.GetLayer(0).GetFeatureCount() >= 2
+
+
+@pytest.mark.slow
+def test_workflow_on_a_local_cluster_gives_the_in_process_products(tmp_path):
+    """EXECUTOR=local for the whole chain (one cluster for OSGM, DSM filter and true ortho): the
+    DSM, filtered DSM, true orthophoto, source index and occlusion mask equal the in-process ones."""
+    pytest.importorskip("distributed")
+    cfg = SceneConfig(
+        extent=(-15.0, -12.0, 15.0, 12.0), n_buildings=1, building_size=(7.0, 9.0), building_gap=3.0,
+        tower=False, image_size=(200, 150), focal_px=250.0, n_oblique=0, seed=7,
+    )  # fmt: skip
+    scene = make_scene(cfg)
+    scene.write(tmp_path / "block")
+    outs = {}
+    for kind in ("inprocess", "local"):
+        out = tmp_path / kind
+        out.mkdir()
+        o = scene.orientation
+        o.image_root = str((tmp_path / "block").resolve())
+        o.save(out / "orientation.json")
+        wc = WorkflowConfig(resolution=2 * cfg.gsd, reuse_orientation=True, executor=kind)
+        if kind == "local":
+            wc.osgm = OsgmConfig(workers=2, worker_memory="1.5GiB")
+        r = run_workflow([], out, config=wc)
+        assert r.stats["executor"].startswith(kind)
+        outs[kind] = out
+    for name in ("dsm_raw.tif", "dsm.tif", "trueortho.tif", "source_index.tif", "occlusion.tif"):
+        a = read_raster(outs["inprocess"] / name, band=None)[0]
+        b = read_raster(outs["local"] / name, band=None)[0]
+        assert np.array_equal(a, b, equal_nan=a.dtype.kind == "f"), name
 
 
 def test_workflow_bad_input(tmp_path):
