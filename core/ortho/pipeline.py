@@ -53,10 +53,11 @@ from .tiles import (
     DoneLabels,
     OrthoContext,
     OrthoTask,
-    candidates_bound,
     ortho_tile_task,
     side_of,
     task_memory,
+    tile_candidates,
+    tile_costs,
     waves,
 )
 from .views import HeightBlocks, prepare_views, tile_views
@@ -517,7 +518,9 @@ def true_ortho(
             workers,
             store=store,
         )
-        k_max = candidates_bound(setup, grid, tiles, to_local)
+        k_tile = tile_candidates(setup, grid, tiles, to_local)
+        k_max = int(max(1, k_tile.max()))
+        cost = dict(zip((t.index for t in tiles), tile_costs(setup, grid, tiles, k_tile), strict=True))
         img_bytes = max(w * h for w, h in (sizes[i] for i in relevant)) * bands * dtype.itemsize * 4 // 3
         memory = task_memory(
             side_of(cfg.tile_size, overlap),
@@ -535,7 +538,9 @@ def true_ortho(
         # a wave runs in batches of at most ~256 MiB of results, so the client's memory is bounded
         per_tile = (cfg.tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
         batch_tiles = max(1, (256 << 20) // per_tile)
-        batches = [w[i : i + batch_tiles] for w in waves(tiles) for i in range(0, len(w), batch_tiles)]
+        # the costliest tiles of a wave first (results do not depend on the order)
+        ordered = [sorted(w, key=lambda t: (-cost[t.index], t.index)) for w in waves(tiles)]
+        batches = [w[i : i + batch_tiles] for w in ordered for i in range(0, len(w), batch_tiles)]
         for wave in batches:
             check(progress)
             tasks = [OrthoTask(t, done.fixed(t)) for t in wave]

@@ -190,18 +190,38 @@ def task_memory(outer_side: int, margin: int, candidates: int, bands: int, image
     return per_candidate + region + int(image_bytes)
 
 
-def candidates_bound(setup: ViewSetup, grid: RasterGrid, tiles: list[Tile], to_local: PlanTransform) -> int:
-    """Most candidate images of one tile: footprint boxes meeting the tile's outer window."""
+def tile_candidates(
+    setup: ViewSetup, grid: RasterGrid, tiles: list[Tile], to_local: PlanTransform
+) -> np.ndarray:
+    """Candidate images per tile (footprint boxes meeting its outer window), int."""
     b = setup.boxes
-    best = 1
-    for t in tiles:
+    out = np.zeros(len(tiles), np.int64)
+    for n, t in enumerate(tiles):
         x0, y0, x1, y1 = t.outer_grid(grid).extent
         lx, ly = to_local.xy(np.array([x0, x1, x0, x1]), np.array([y0, y0, y1, y1]))
         with np.errstate(invalid="ignore"):
             hit = (b[:, 0] <= lx.max()) & (b[:, 2] >= lx.min())
             hit &= (b[:, 1] <= ly.max()) & (b[:, 3] >= ly.min())
-        best = max(best, int(np.count_nonzero(hit)))
-    return best
+        out[n] = int(np.count_nonzero(hit))
+    return out
+
+
+def tile_costs(setup: ViewSetup, grid: RasterGrid, tiles: list[Tile], candidates: np.ndarray) -> np.ndarray:
+    """Relative cost of each tile: candidates x outer cells + the occluder region's cells.
+
+    Used to start the costliest tiles of a wave first (longest-processing-time order), so a
+    tile near a tower does not start last and keep the other workers waiting.
+    """
+    out = np.empty(len(tiles))
+    tan_v = float(np.tan(setup.max_view))
+    for n, t in enumerate(tiles):
+        og = t.outer_grid(grid)
+        m = setup.margin_cells
+        if setup.blocks is not None and m > 0:
+            m = setup.blocks.margin(og, m, tan_v)
+        cells = og.rows * og.cols
+        out[n] = max(int(candidates[n]), 1) * cells + 0.5 * (og.rows + 2 * m) * (og.cols + 2 * m)
+    return out
 
 
 def side_of(tile_size: int, overlap: int) -> int:
@@ -211,7 +231,8 @@ def side_of(tile_size: int, overlap: int) -> int:
 __all__ = [
     "OrthoContext",
     "OrthoTask",
-    "candidates_bound",
+    "tile_candidates",
+    "tile_costs",
     "DoneLabels",
     "ortho_tile_task",
     "side_of",
