@@ -14,6 +14,10 @@ nadir block + 4 obliques, per-image exposure differences):
   (``visibility=False``) for the quality comparison;
 * ``--surface PATH``: another DSM of the same scene (e.g. from ``truortho:osgm``) instead of the
   truth DSM, for ours and Orthority alike; the quality is still measured against the truth;
+* **Orthority + GDAL mosaic**: Orthority's per-image orthos are not a mosaic; a finished conventional
+  block ortho also needs them mosaicked: ``gdal.BuildVRT`` over them on our grid (last image on
+  top) + ``gdal.Translate`` to a COG with overviews like ours, timed in its own subprocess. The
+  ratio of mosaic output rates compares like with like: the same cells and bands written;
 * **Orthority** (pip ``orthority``, installed into a throw-away virtual environment under
   ``$TMPDIR`` on first use, never into .venv): ``oty.Ortho.process`` of every image onto the same
   DSM at the same resolution, bilinear image and DEM interpolation, one ortho per image (what a
@@ -97,6 +101,28 @@ ORTHORITY = textwrap.dedent(
             valid += int((m > 0).sum()) * ds.count
     print(json.dumps({"seconds": dt, "pixels": px, "valid_pixels": valid, "images": len(files),
                       "version": oty.__version__ if hasattr(oty, "__version__") else "?",
+                      "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+    """
+)
+
+
+MOSAIC = textwrap.dedent(
+    """
+    import glob, json, resource, sys, time
+    from osgeo import gdal
+    gdal.UseExceptions()
+    folder, out, extent, res = sys.argv[1], sys.argv[2], [float(v) for v in sys.argv[3].split(",")], \\
+        float(sys.argv[4])
+    files = sorted(glob.glob(folder + "/*.tif"))
+    t = time.perf_counter()
+    vrt = gdal.BuildVRT(out + ".vrt", files, outputBounds=extent, xRes=res, yRes=res, srcNodata=None,
+                        resampleAlg="nearest")
+    vrt = None
+    gdal.Translate(out, out + ".vrt", format="COG", creationOptions=["COMPRESS=DEFLATE", "PREDICTOR=YES",
+                   "NUM_THREADS=ALL_CPUS", "BLOCKSIZE=256", "OVERVIEW_RESAMPLING=AVERAGE"])
+    dt = time.perf_counter() - t
+    ds = gdal.Open(out)
+    print(json.dumps({"seconds": dt, "pixels": ds.RasterXSize * ds.RasterYSize * 3,
                       "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
     """
 )
@@ -259,6 +285,13 @@ def main() -> int:
         results["ratio_output_rate"] = round(ours_mpx / results["orthority"]["mpix_per_s"], 3)
         results["ratio_output_rate_valid"] = round(ours_mpx / results["orthority"]["valid_mpix_per_s"], 3)
         results["ratio_time_for_the_block"] = round(oo["seconds"] / ours["seconds"], 3)
+        # a finished conventional mosaic: Orthority's orthos mosaicked by GDAL (VRT, last image on top,
+        # + COG with overviews like ours), the same grid and pixels as ours
+        mo = run_json([py, "-P", "-c", MOSAIC, os.path.join(work, "orthority"),
+                       os.path.join(work, "orthority_mosaic.tif"), ext, str(res)], env)  # fmt: skip
+        results["orthority_mosaic"] = mo
+        block = oo["seconds"] + mo["seconds"]
+        results["ratio_mosaic_rate"] = round(block / ours["seconds"], 3)
         # like with like: one Orthority ortho pixel with data = one (cell, image) sample of ours
         ours_sps = ours["stats"]["cell_image_samples"] * ours["bands"] / ours["seconds"] / 1e6
         results["ours"]["sample_mpix_per_s"] = round(ours_sps, 3)
@@ -281,6 +314,12 @@ def main() -> int:
             f"{results['ratio_output_rate_valid']} (valid pixels only); Orthority time / ours for the whole "
             f"block: {results['ratio_time_for_the_block']}; (cell, image) samples per second of ours / "
             f"Orthority's valid pixels per second: {results['ratio_sample_rate']}"
+        )
+        mo = results["orthority_mosaic"]
+        print(
+            f"finished mosaic of the block (same {ours['cells']} cells x {ours['bands']} bands): Orthority "
+            f"{results['orthority']['seconds']:.2f} s + GDAL VRT/COG mosaic {mo['seconds']:.2f} s; "
+            f"ratio of mosaic output rates ours / (Orthority + GDAL): {results['ratio_mosaic_rate']}"
         )
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
     name = "trueortho.json" if not args.surface else "trueortho_surface.json"
