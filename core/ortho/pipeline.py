@@ -43,7 +43,7 @@ from ..errors import CancelledError, CRSError, InputError, MissingFileError
 from ..grid import RasterGrid
 from ..imagery import image_info
 from ..orientation import Orientation, as_orientation
-from ..parallel import Digest, InProcessExecutor, TileCache, file_identity
+from ..parallel import Digest, InProcessExecutor, file_identity, tile_run
 from ..progress import Progress, Steps, SubProgress, as_progress, check
 from .color import ColorCorrection, estimate_corrections, to_channels
 from .mosaic import ImageStore, MosaicParams, candidate_colours
@@ -423,21 +423,6 @@ def true_ortho(
     t0 = time.perf_counter()
     overlap = max(cfg.blend_width, 4) + 8
     tiles = grid.tiles(cfg.tile_size, overlap)
-    own_executor = executor is None
-    if executor is None:
-        from ..parallel import make_executor
-
-        executor = make_executor(cfg.executor, cfg.scheduler_address, n_workers=cfg.dask_workers)
-    tile_executor = executor
-    if isinstance(executor, InProcessExecutor) and executor.threads < workers:
-        # in this process the tiles of a wave run in ``workers`` threads (they are independent)
-        tile_executor = InProcessExecutor(threads=workers)
-    cache = None
-    if cfg.cache_dir is not None:
-        cache = TileCache(cfg.cache_dir)
-    else:  # scratch tiles: a rerun after a crash resumes from them; removed after success
-        cache = TileCache(f"{os.fspath(output)}.tiles", remove_when_done=True)
-    stats["executor"] = getattr(executor, "name", type(executor).__name__)
     sub = steps[2]
     parts: dict[int, list] = {}
     counts = np.zeros(len(o.images), np.int64)
@@ -447,15 +432,22 @@ def true_ortho(
     with contextlib.ExitStack() as stack:
         from ..rasterio_io import RasterWriter
 
-        if own_executor:
-            stack.callback(executor.close)
-        if cache is not None:
-            # a cancelled run leaves no scratch tiles (a crash keeps them for the rerun)
-            stack.push(
-                lambda et, ev, tb: cache.finish()
-                if et is not None and issubclass(et, CancelledError)
-                else None
+        # scratch tiles beside the output: a rerun after a crash resumes from them
+        executor, cache = stack.enter_context(
+            tile_run(
+                executor,
+                cfg.executor,
+                cfg.scheduler_address,
+                scratch=f"{os.fspath(output)}.tiles",
+                cache_dir=cfg.cache_dir,
+                n_workers=cfg.dask_workers,
             )
+        )
+        stats["executor"] = getattr(executor, "name", type(executor).__name__)
+        tile_executor = executor
+        if isinstance(executor, InProcessExecutor) and executor.threads < workers:
+            # in this process the tiles of a wave run in ``workers`` threads (they are independent)
+            tile_executor = InProcessExecutor(threads=workers)
 
         w_out = stack.enter_context(
             RasterWriter(
@@ -531,9 +523,7 @@ def true_ortho(
         )
         stats["max_candidates_per_tile"] = k_max
         stats["task_memory_mb"] = round(memory / 2**20, 1)
-        base = ""
-        if cache is not None:
-            base = _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs)
+        base = _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs)
         n_done = 0
         # a wave runs in batches of at most ~256 MiB of results, so the client's memory is bounded
         per_tile = (cfg.tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
@@ -552,7 +542,7 @@ def true_ortho(
                     wsub,
                     shared=ctx,
                     cache=cache,
-                    key=(lambda t: t.key(base)) if cache is not None else None,
+                    key=lambda t: t.key(base),
                     label="true ortho",
                     memory=memory,
                 )
@@ -579,9 +569,7 @@ def true_ortho(
         check(progress)
         steps[3].update(0.0, "writing overviews")
     stats["seconds_mosaic"] = round(time.perf_counter() - t0, 3)
-    if cache is not None:
-        stats["tile_cache"] = {"hits": cache.hits, "written": cache.written}
-        cache.finish()
+    stats["tile_cache"] = {"hits": cache.hits, "written": cache.written}
     regions = [SeamRegion(k, o.images[k].name, int(counts[k]), g) for k, g in dissolve(parts).items()]
     stats.update(
         {

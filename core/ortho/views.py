@@ -455,7 +455,8 @@ def tile_views(
     clean_count = np.zeros(rows * cols, np.int32)
     cells = vidx
     results_by: dict[int, tuple | None] = {}
-    batch = LAZY_BATCH  # fixed, so the result does not depend on the threads
+    # lazy: fixed batches, so the result does not depend on the threads; else all in one batch
+    batch = LAZY_BATCH if setup.views_per_cell > 0 else max(len(order), 1)
     pool = None
     if workers > 1 and len(order) > 1:
         from concurrent.futures import ThreadPoolExecutor

@@ -47,8 +47,8 @@ from ..parallel import (
     InProcessExecutor,
     TileCache,
     file_identity,
-    make_executor,
     parse_memory,
+    tile_run,
 )
 from ..progress import Progress, as_progress
 from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
@@ -686,18 +686,6 @@ def run_osgm(
     off = o.offset
     local = RasterGrid(grid.x_min - off[0], grid.y_max - off[1], res, grid.rows, grid.cols, o.crs)
     pyr = ImagePyramid(paths, sizes, cfg.band, cfg.cache_bytes)
-    own_executor = executor is None
-    if executor is None:
-        executor = make_executor(
-            cfg.executor,
-            cfg.scheduler_address,
-            n_workers=cfg.workers,
-            memory_limit=parse_memory(cfg.worker_memory),
-        )
-    if cfg.cache_dir is not None:
-        cache = TileCache(cfg.cache_dir)
-    else:
-        cache = TileCache(f"{outputs.dsm}.tiles", remove_when_done=True)
     # everything a tile's result depends on besides its own inputs: block, parameters, grid, Z surface
     cache_base = Digest(
         "osgm-run",
@@ -706,17 +694,19 @@ def run_osgm(
         [local.x_min, local.y_max, local.res, local.rows, local.cols],
         None if z_surface is None else list(file_identity(z_surface)),
     ).hexdigest()
-    try:
+    with tile_run(
+        executor,
+        cfg.executor,
+        cfg.scheduler_address,
+        scratch=f"{outputs.dsm}.tiles",
+        cache_dir=cfg.cache_dir,
+        n_workers=cfg.workers,
+        memory_limit=parse_memory(cfg.worker_memory),
+    ) as (executor, cache):
         return _run_systems(
             o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
             z_surface, progress, t0,
         )  # fmt: skip
-    except CancelledError:
-        cache.finish()
-        raise
-    finally:
-        if own_executor:
-            executor.close()
 
 
 def _run_systems(
@@ -812,7 +802,6 @@ def _run_systems(
         "task_volume_bytes": 4 * nadir.max_volume,
         "seconds": time.perf_counter() - t0,
     }
-    cache.finish()
     progress.update(1.0, "OSGM done")
     return OsgmResult(grid, stats, written)
 

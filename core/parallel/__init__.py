@@ -16,6 +16,7 @@ from .executors import (
     make_executor,
     parse_memory,
     task_cancelled,
+    tile_run,
     tune_worker_malloc,
 )
 
@@ -35,5 +36,6 @@ __all__ = [
     "make_executor",
     "parse_memory",
     "task_cancelled",
+    "tile_run",
     "tune_worker_malloc",
 ]

@@ -65,6 +65,7 @@ for more than the largest worker declares asks for that worker's amount.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import uuid
@@ -248,8 +249,15 @@ class _DaskBase(_Base):
     retries = RETRIES
     poll = 0.5  # seconds between cancel checks while waiting
 
+    client: Any = None
+
     def _client(self):
         raise NotImplementedError
+
+    def close(self) -> None:
+        if self.client is not None:
+            self.client.close()
+            self.client = None
 
     def _slots(self, client) -> int:
         threads = sum(client.nthreads().values()) or 1
@@ -432,9 +440,7 @@ class LocalDaskExecutor(_DaskBase):
         return f"local Dask cluster, {self.n_workers} worker process(es) on 127.0.0.1"
 
     def close(self) -> None:
-        if self.client is not None:
-            self.client.close()
-            self.client = None
+        super().close()
         if self.cluster is not None:
             self.cluster.close()
             self.cluster = None
@@ -521,11 +527,6 @@ class SchedulerExecutor(_DaskBase):
     def describe(self) -> str:
         return f"Dask scheduler {self.address}"
 
-    def close(self) -> None:
-        if self.client is not None:
-            self.client.close()
-            self.client = None
-
 
 def make_executor(
     kind: str | None = None,
@@ -544,6 +545,40 @@ def make_executor(
     if kind == "scheduler":
         return SchedulerExecutor(address, security)
     raise InputError(f"EXECUTOR: expected one of {', '.join(EXECUTORS)}, got {kind!r}")
+
+
+@contextlib.contextmanager
+def tile_run(
+    executor=None,
+    kind: str | None = None,
+    address: str | None = None,
+    *,
+    scratch,
+    cache_dir=None,
+    n_workers: int | None = None,
+    memory_limit=None,
+):
+    """``(executor, cache)`` of one tiled run, as a context.
+
+    The executor is ``executor`` or, when None, one made by :func:`make_executor` from ``kind``
+    and ``address`` (closed at the end). The tile cache is ``cache_dir`` (kept) or the scratch
+    folder ``scratch``, removed when the run succeeds or is cancelled and kept after any other
+    error, so that a rerun after a crash resumes from its tiles.
+    """
+    own = executor is None
+    if own:
+        executor = make_executor(kind, address, n_workers=n_workers, memory_limit=memory_limit)
+    cache = TileCache(cache_dir) if cache_dir is not None else TileCache(scratch, remove_when_done=True)
+    try:
+        yield executor, cache
+    except CancelledError:
+        cache.finish()
+        raise
+    else:
+        cache.finish()
+    finally:
+        if own:
+            executor.close()
 
 
 def parse_memory(value) -> int | None:
