@@ -141,9 +141,13 @@ def _decode(path: str) -> np.ndarray:
     return img
 
 
-def _read_rasterio(path: str, window=None) -> np.ndarray | None:
+def _read_rasterio(path: str, window=None, out_shape=None) -> np.ndarray | None:
+    """All bands of ``path`` (or of ``window = (x, y, w, h)``), (h, w) or (h, w, bands); with
+    ``out_shape = (rows, cols)`` decimated by averaging (rasterio uses the file's overviews).
+    None without rasterio."""
     try:
         import rasterio
+        from rasterio.enums import Resampling
         from rasterio.windows import Window
     except ImportError:
         return None
@@ -153,10 +157,39 @@ def _read_rasterio(path: str, window=None) -> np.ndarray | None:
             ds = rasterio.open(path)
         with ds:
             win = None if window is None else Window(*window)
-            data = ds.read(window=win)
+            shape = None if out_shape is None else (ds.count, int(out_shape[0]), int(out_shape[1]))
+            data = ds.read(window=win, out_shape=shape, resampling=Resampling.average)
     except Exception as exc:
         raise FormatError(path, f"not a readable image ({exc})") from None
     return data[0] if data.shape[0] == 1 else np.ascontiguousarray(np.moveaxis(data, 0, -1))
+
+
+def read_level_window(
+    path, size: tuple[int, int], level: int, x0: int, y0: int, w: int, h: int
+) -> np.ndarray:
+    """Window ``[x0, x0 + w) x [y0, y0 + h)`` of an image at pyramid ``level`` (halvings of
+    ``size = (width, height)``), read through rasterio: decimated by averaging (the file's overviews
+    when it has them), native dtype, cropped at the image border.
+
+    Raises
+    ------
+    InputError
+        ``level`` or the window is invalid, or rasterio is missing.
+    FormatError
+        The file cannot be read.
+    """
+    if level < 0 or w <= 0 or h <= 0 or x0 < 0 or y0 < 0:
+        raise InputError(f"{path}: bad image window level {level}, ({x0}, {y0}, {w}, {h})")
+    f = 2**level
+    W, H = size
+    win = (x0 * f, y0 * f, min(w * f, W - x0 * f), min(h * f, H - y0 * f))
+    if win[2] <= 0 or win[3] <= 0:
+        raise InputError(f"{path}: window ({x0}, {y0}, {w}, {h}) at level {level} is outside the image")
+    shape = None if level == 0 else (-(-win[3] // f), -(-win[2] // f))
+    img = _read_rasterio(str(path), win, shape)
+    if img is None:
+        raise InputError(f"{path}: rasterio is needed to read windows of this image")
+    return img[:h, :w]
 
 
 def _select_band(img: np.ndarray, band: int | None, path: str) -> np.ndarray:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FormatError, InputError
-from ..imagery import read_image_sized
+from ..imagery import read_image_sized, read_level_window
 from ..jit import njit
 from .color import ColorCorrection, value_scale
 from .seams import feather_weights
@@ -150,39 +150,16 @@ class ImageStore:
         return self._read_window(i, level, x0, y0, x1 - x0, y1 - y0), (x0, y0), (lw, lh)
 
     def _read_window(self, i: int, level: int, x0: int, y0: int, w: int, h: int) -> np.ndarray:
-        """Window of level ``level`` read through rasterio (decimated by averaging; overviews used)."""
-        import warnings
-
-        import rasterio
-        from rasterio.enums import Resampling
-        from rasterio.windows import Window
-
-        f = 2**level
-        W, H = self.sizes[i]
-        fx0, fy0 = x0 * f, y0 * f
-        fw, fh = min(w * f, W - fx0), min(h * f, H - fy0)
-        try:
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", rasterio.errors.NotGeoreferencedWarning)
-                with rasterio.open(self.paths[i]) as ds:
-                    if (ds.width, ds.height) != (W, H) or ds.count != self.bands:
-                        raise FormatError(
-                            self.paths[i],
-                            f"image is {ds.width} x {ds.height} with {ds.count} band(s), expected "
-                            f"{W} x {H} with {self.bands}",
-                        )
-                    data = ds.read(
-                        window=Window(fx0, fy0, fw, fh),
-                        out_shape=(ds.count, h, w) if level else None,
-                        resampling=Resampling.average,
-                    )
-        except rasterio.errors.RasterioIOError as exc:
-            raise FormatError(self.paths[i], f"not a readable image ({exc})") from None
-        if data.dtype != self.dtype:
-            raise FormatError(self.paths[i], f"image is {data.dtype}, the block {self.dtype}")
+        """Window of level ``level`` (:func:`~truortho.core.imagery.read_level_window`)."""
+        img = read_level_window(self.paths[i], self.sizes[i], level, x0, y0, w, h)
+        nb = 1 if img.ndim == 2 else img.shape[2]
+        if nb != self.bands or img.dtype != self.dtype:
+            raise FormatError(
+                self.paths[i],
+                f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
+            )
         self.window_reads += 1
-        img = data[0] if data.shape[0] == 1 else np.moveaxis(data, 0, -1)
-        return np.ascontiguousarray(img)
+        return img
 
     def level_for(self, gsd: float, res: float) -> int:
         """Level whose pixel (``gsd * 2**level``) is at most the output cell ``res``."""

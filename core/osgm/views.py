@@ -21,14 +21,20 @@ decoded once and kept in a least-recently-used cache bounded in bytes.
 from __future__ import annotations
 
 import math
-import warnings
 from collections import OrderedDict
 
 import numpy as np
 
 from ..errors import InputError
 from ..geometry.camera import Camera, _distort_one
-from ..imagery import _read_rasterio, _use_rasterio, check_image_size, image_info, luminance, read_image_sized
+from ..imagery import (
+    _use_rasterio,
+    check_image_size,
+    image_info,
+    luminance,
+    read_image_sized,
+    read_level_window,
+)
 from ..jit import njit
 
 
@@ -238,33 +244,12 @@ class ImagePyramid:
 
     def _read_window(self, i, level, x0, y0, w, h, colour) -> np.ndarray:
         """Windowed read of a rasterio source at a reduced level (its overviews when present)."""
-        f = 2**level
-        W0, H0 = self.sizes[i]
-        win = (x0 * f, y0 * f, min(w * f, W0 - x0 * f), min(h * f, H0 - y0 * f))
-        shape = (-(-win[3] // f), -(-win[2] // f))
-        img = _read_rasterio(self.paths[i], win) if level == 0 else self._read_decimated(i, win, shape)
-        if img is None:
-            raise InputError(f"{self.paths[i]}: rasterio is needed to read windows of this image")
+        img = read_level_window(self.paths[i], self.sizes[i], level, x0, y0, w, h)
         self.reads += 1
         out = self._convert(img, colour)
         if out.ndim == 2 and colour:
             out = out[:, :, None]
-        return out[:h, :w]
-
-    def _read_decimated(self, i, win, shape):
-        import rasterio
-        from rasterio.enums import Resampling
-        from rasterio.windows import Window
-
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", rasterio.errors.NotGeoreferencedWarning)
-            with rasterio.open(self.paths[i]) as ds:
-                data = ds.read(
-                    window=Window(*win),
-                    out_shape=(ds.count, shape[0], shape[1]),
-                    resampling=Resampling.average,
-                )
-        return data[0] if data.shape[0] == 1 else np.ascontiguousarray(np.moveaxis(data, 0, -1))
+        return out
 
 
 def check_images(paths, sizes) -> None:

@@ -89,6 +89,30 @@ def test_tiff_window_through_rasterio(tmp_path):
     assert image_info(p).dtype == "uint16"
 
 
+def test_level_window_reads_the_decimated_window(tmp_path):
+    import rasterio
+
+    from truortho.core.imagery import read_level_window
+
+    rng = np.random.default_rng(0)
+    a = rng.integers(0, 255, (3, 100, 130), dtype=np.uint8)
+    p = tmp_path / "t.tif"
+    with rasterio.open(p, "w", driver="GTiff", width=130, height=100, count=3, dtype="uint8",
+                       tiled=True, blockxsize=32, blockysize=32) as ds:  # fmt: skip
+        ds.write(a)
+    img = np.moveaxis(a, 0, -1)
+    assert np.array_equal(read_level_window(p, (130, 100), 0, 10, 20, 30, 25), img[20:45, 10:40])
+    # level 1: 2 x 2 means; the last column of the level (65) is cropped at the image border
+    w = read_level_window(p, (130, 100), 1, 60, 10, 10, 4)
+    assert w.shape == (4, 5, 3)
+    means = img.reshape(50, 2, 65, 2, 3).astype(float).mean(axis=(1, 3))[10:14, 60:65]
+    assert np.abs(w.astype(float) - means).max() <= 1
+    with pytest.raises(InputError, match="outside the image"):
+        read_level_window(p, (130, 100), 1, 70, 0, 4, 4)
+    with pytest.raises(InputError, match="bad image window"):
+        read_level_window(p, (130, 100), 0, 0, 0, 0, 4)
+
+
 def test_luminance_rec601():
     img = np.zeros((1, 3, 3), np.uint8)
     img[0, 0] = (255, 0, 0)
