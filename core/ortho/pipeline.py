@@ -355,7 +355,7 @@ def true_ortho(
         top_views=cfg.top_views,
     )
     if cfg.visibility and setup.margin_cells > 0:
-        setup.blocks = HeightBlocks.of(surf, grid)
+        setup.blocks = HeightBlocks.of(surf, grid, progress=progress)
     # ---- images that can contribute: on disk, one band count and dtype
     ex_x, ex_y = to_local.xy(np.array([gx0, gx1, gx0, gx1]), np.array([gy0, gy0, gy1, gy1]))
     b = setup.boxes

@@ -223,34 +223,20 @@ class DsmSurface:
 
         dst = np.full(grid.shape, np.nan, np.float64)
         with rasterio.open(self.path) as ds:
-            win = _aligned_window(ds, grid, self.crs)
-            if win is not None and ds.width * ds.height <= self.memory_cells:
-                # a DSM this small is read once and kept (tiles read overlapping regions of it)
-                if self._array is None:
-                    a = ds.read(self.band).astype(np.float64)
-                    if ds.nodata is not None:
-                        a[a == ds.nodata] = np.nan
-                    a[~np.isfinite(a)] = np.nan
-                    self._array = a
-                r0, c0 = win
-                rs0, cs0 = max(r0, 0), max(c0, 0)
-                rs1, cs1 = min(r0 + grid.rows, ds.height), min(c0 + grid.cols, ds.width)
-                if rs1 > rs0 and cs1 > cs0:
-                    dst[rs0 - r0 : rs1 - r0, cs0 - c0 : cs1 - c0] = self._array[rs0:rs1, cs0:cs1]
-                return dst
-            if win is not None:  # same CRS and cells: a windowed read, no resampling
-                r0, c0 = win
-                rs0, cs0 = max(r0, 0), max(c0, 0)
-                rs1, cs1 = min(r0 + grid.rows, ds.height), min(c0 + grid.cols, ds.width)
-                if rs1 > rs0 and cs1 > cs0:
-                    from rasterio.windows import Window
-
-                    a = ds.read(self.band, window=Window(cs0, rs0, cs1 - cs0, rs1 - rs0)).astype(np.float64)
-                    if ds.nodata is not None:
-                        a[a == ds.nodata] = np.nan
-                    dst[rs0 - r0 : rs1 - r0, cs0 - c0 : cs1 - c0] = a
-                dst[~np.isfinite(dst)] = np.nan
-                return dst
+            win = _aligned_offset(ds.transform, self.crs, grid)
+            if win is not None:  # same CRS and cells: no resampling
+                if ds.width * ds.height <= self.memory_cells:
+                    # a DSM this small is read once and kept (tiles read overlapping regions of it)
+                    if self._array is None:
+                        self._array = _read_heights(ds, self.band)
+                    full = self._array
+                    return _paste(dst, win, full.shape, lambda a0, b0, a1, b1: full[a0:a1, b0:b1])
+                return _paste(
+                    dst,
+                    win,
+                    (ds.height, ds.width),
+                    lambda a0, b0, a1, b1: _read_heights(ds, self.band, (a0, b0, a1, b1)),
+                )
             try:
                 reproject(
                     source=rasterio.band(ds, self.band),
@@ -300,17 +286,10 @@ class ArraySurface(DsmSurface):
         return float(v.min()), float(v.max())
 
     def heights_on(self, grid: RasterGrid) -> np.ndarray:
-        if same_crs(grid.crs, self.crs) and math.isclose(grid.res, self.res, rel_tol=1e-9):
-            fr = (self.grid.y_max - grid.y_max) / grid.res
-            fc = (grid.x_min - self.grid.x_min) / grid.res
-            if abs(fr - round(fr)) < 1e-6 and abs(fc - round(fc)) < 1e-6:
-                out = np.full(grid.shape, np.nan)
-                r0, c0 = int(round(fr)), int(round(fc))
-                rs0, cs0 = max(r0, 0), max(c0, 0)
-                rs1, cs1 = min(r0 + grid.rows, self.grid.rows), min(c0 + grid.cols, self.grid.cols)
-                if rs1 > rs0 and cs1 > cs0:
-                    out[rs0 - r0 : rs1 - r0, cs0 - c0 : cs1 - c0] = self.h[rs0:rs1, cs0:cs1]
-                return out
+        win = _aligned_offset(self.grid.transform, self.crs, grid)
+        if win is not None:
+            out = np.full(grid.shape, np.nan)
+            return _paste(out, win, self.h.shape, lambda a0, b0, a1, b1: self.h[a0:a1, b0:b1])
         from rasterio.warp import reproject
 
         dst = np.full(grid.shape, np.nan, np.float64)
@@ -331,10 +310,9 @@ class ArraySurface(DsmSurface):
         return dst
 
 
-def _aligned_window(ds, grid: RasterGrid, crs) -> tuple[int, int] | None:
-    """(row, col) of ``grid``'s first cell in the raster ``ds`` when both share CRS, cell size and
-    cell edges (north-up), else None."""
-    t = ds.transform
+def _aligned_offset(t, crs, grid: RasterGrid) -> tuple[int, int] | None:
+    """(row, col) of ``grid``'s first cell in a raster of transform ``t`` and CRS ``crs`` when both
+    share CRS, cell size and cell edges (north-up), else None."""
     if not (t.b == 0 and t.d == 0 and t.e < 0) or not same_crs(grid.crs or crs, crs):
         return None
     if not (math.isclose(t.a, grid.res, rel_tol=1e-9) and math.isclose(-t.e, grid.res, rel_tol=1e-9)):
@@ -344,6 +322,32 @@ def _aligned_window(ds, grid: RasterGrid, crs) -> tuple[int, int] | None:
     if abs(fr - round(fr)) > 1e-6 or abs(fc - round(fc)) > 1e-6:
         return None
     return int(round(fr)), int(round(fc))
+
+
+def _paste(dst: np.ndarray, offset: tuple[int, int], src_shape: tuple[int, ...], read) -> np.ndarray:
+    """Fill ``dst`` (a grid starting at ``offset`` of a source of ``src_shape``) with
+    ``read(r0, c0, r1, c1)`` of the overlapping source rows/cols; the rest stays as it is."""
+    r0, c0 = offset
+    rows, cols = dst.shape
+    rs0, cs0 = max(r0, 0), max(c0, 0)
+    rs1, cs1 = min(r0 + rows, src_shape[0]), min(c0 + cols, src_shape[1])
+    if rs1 > rs0 and cs1 > cs0:
+        dst[rs0 - r0 : rs1 - r0, cs0 - c0 : cs1 - c0] = read(rs0, cs0, rs1, cs1)
+    return dst
+
+
+def _read_heights(ds, band: int, window: tuple[int, int, int, int] | None = None) -> np.ndarray:
+    """Heights of an open raster (or of rows r0:r1, cols c0:c1) as float64, NaN for nodata."""
+    from rasterio.windows import Window
+
+    win = (
+        None if window is None else Window(window[1], window[0], window[3] - window[1], window[2] - window[0])
+    )
+    a = ds.read(band, window=win).astype(np.float64)
+    if ds.nodata is not None:
+        a[a == ds.nodata] = np.nan
+    a[~np.isfinite(a)] = np.nan
+    return a
 
 
 def _resampling(surface, grid: RasterGrid):

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..geometry.camera import Camera
 from ..grid import RasterGrid, Tile
 from ..jit import njit
@@ -81,13 +82,21 @@ class HeightBlocks:
     hmin: np.ndarray  # +inf where no data
 
     @classmethod
-    def of(cls, surface, grid: RasterGrid, block: int = 32, strip_cells: int = 4_000_000) -> HeightBlocks:
-        """Read the surface on ``grid`` by strips of whole block rows (bounded memory)."""
+    def of(
+        cls, surface, grid: RasterGrid, block: int = 32, strip_cells: int = 4_000_000, progress=None
+    ) -> HeightBlocks:
+        """Read the surface on ``grid`` by strips of whole block rows (bounded memory); ``progress``
+        (optional) is checked for a cancel before every strip."""
+        from ..progress import check
+
+        if not (isinstance(block, int) and block > 0):
+            raise InputError(f"HeightBlocks: block must be a positive integer, got {block!r}")
         nbr, nbc = -(-grid.rows // block), -(-grid.cols // block)
         hmax = np.full((nbr, nbc), -np.inf)
         hmin = np.full((nbr, nbc), np.inf)
         rows_per = max(1, strip_cells // max(grid.cols * block, 1)) * block
         for r0 in range(0, grid.rows, rows_per):
+            check(progress)
             nr = min(rows_per, grid.rows - r0)
             h = surface.heights_on(grid.window(r0, 0, nr, grid.cols))
             pr, pc = -(-nr // block) * block, nbc * block
