@@ -221,7 +221,7 @@ def estimate_corrections(
     rms_before, rms_after, mad_before, mad_after = [], [], [], []
     for ch in range(nch):
         xa, xb = val[ii, ch], val[jj, ch]
-        g, o = _moment_match(upairs, inverse, counts, xa, xb, n, prior, huber, iterations, min_pair)
+        g, o = _moment_match(upairs, inverse, counts, xa, xb, ia, ib, n, prior, huber, iterations, min_pair)
         gain[:, ch] = g
         offset[:, ch] = o
         ra = (xa - xb) ** 2
@@ -267,8 +267,11 @@ def _group_percentiles(xs, starts, n, qs, out):
             out[g, j] = np.partition(v, r)[r]
 
 
-def _moment_match(upairs, inverse, counts, xa, xb, n, prior, huber, iterations, min_pair):
+def _moment_match(upairs, inverse, counts, xa, xb, ia, ib, n, prior, huber, iterations, min_pair):
     """Gains and offsets that equalise the robust moments of every overlapping image pair.
+
+    ``xa``, ``xb``: the two values of every observation pair, ``ia``, ``ib`` their images
+    (``ia * n + ib`` is the pair id that ``upairs[inverse]`` groups).
 
     For an image pair ``(a, b)`` seen together on ``m`` cells with robust spreads
     ``s`` over those cells, the corrected images have equal spreads when
@@ -298,8 +301,7 @@ def _moment_match(upairs, inverse, counts, xa, xb, n, prior, huber, iterations, 
     g = np.exp(lg)
     g /= g.mean()  # the block's level: mean gain 1 (the ratios are what the pairs determine)
     # offsets: given the gains, the median of the paired differences of the cells (content cancels)
-    pa, pb = upairs[inverse] // n, upairs[inverse] % n
-    dmed, _ = _robust_moments(g[pb] * xb - g[pa] * xa, inverse, k, order)
+    dmed, _ = _robust_moments(g[ib] * xb - g[ia] * xa, inverse, k, order)
     scale = float(np.median(np.concatenate([sa[ok], sb[ok]])))
     o = _pair_solve(a_img[ok], b_img[ok], dmed[ok], w0[ok], n, prior, huber, iterations, scale)
     return g, o
