@@ -179,6 +179,14 @@ class TrueOrthoConfig:
             bad("max_view_angle", "expected degrees in (0, 89)")
         if not isinstance(self.blend_width, int) or not 0 <= self.blend_width <= 1000:
             bad("blend_width", "expected an integer number of cells in [0, 1000]")
+        if isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1:
+            bad("workers", "expected a positive number of threads")
+        if self.dask_workers is not None and (
+            isinstance(self.dask_workers, bool)
+            or not isinstance(self.dask_workers, int)
+            or self.dask_workers < 1
+        ):
+            bad("dask_workers", "expected a positive number of worker processes (or None)")
         if not isinstance(self.top_views, int) or not 0 <= self.top_views <= 1000:
             bad("top_views", "expected an integer >= 0 (0 = every image)")
         if not isinstance(self.views_per_cell, int) or not 0 <= self.views_per_cell <= 1000:

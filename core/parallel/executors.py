@@ -186,7 +186,9 @@ class InProcessExecutor(_Base):
     threads = 1
 
     def __init__(self, threads: int = 1) -> None:
-        self.threads = max(1, int(threads))
+        if isinstance(threads, bool) or not isinstance(threads, int) or threads < 1:
+            raise InputError(f"threads: expected a positive integer, got {threads!r}")
+        self.threads = threads
 
     def _run(self, fn, n, materialise, store, shared, progress, memory=None) -> None:
         global _cancel_hook
@@ -407,6 +409,7 @@ class LocalDaskExecutor(_DaskBase):
         self.memory_limit = (
             memory_limit if memory_limit is not None else _worker_memory_default(self.n_workers)
         )
+        self.memory_bytes = parse_memory(self.memory_limit)  # checked now; the workers' MEMORY resource
         self.numba_threads = int(numba_threads or max(1, cores // self.n_workers))
         self.cluster = None
         self.client = None
@@ -429,7 +432,7 @@ class LocalDaskExecutor(_DaskBase):
             memory_limit=self.memory_limit,
             dashboard_address=None,
             env={"NUMBA_NUM_THREADS": str(self.numba_threads)},
-            resources={"MEMORY": float(parse_memory(self.memory_limit) or _worker_memory_default(1))},
+            resources={"MEMORY": float(self.memory_bytes or _worker_memory_default(self.n_workers))},
         )
 
     def worker_pids(self) -> dict[str, int]:

@@ -265,6 +265,21 @@ def test_local_cluster_listens_on_loopback_only(cluster):
     assert all(a.ip == "127.0.0.1" for a in listening), listening
 
 
+def test_executor_and_ortho_parameters_are_checked():
+    from truortho.core.ortho.pipeline import TrueOrthoConfig
+
+    with pytest.raises(InputError, match="threads"):
+        InProcessExecutor(threads=0)
+    with pytest.raises(InputError, match="memory"):
+        LocalDaskExecutor(1, memory_limit="lots")  # before any cluster starts
+    with pytest.raises(InputError, match="workers"):
+        TrueOrthoConfig(workers=0).validate()
+    with pytest.raises(InputError, match="dask_workers"):
+        TrueOrthoConfig(dask_workers=0).validate()
+    with pytest.raises(InputError, match="executor"):
+        TrueOrthoConfig(executor="gpu").validate()
+
+
 def test_in_process_threads_keep_task_order_and_stop_on_cancel():
     import threading
 
