@@ -626,12 +626,7 @@ def _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs) -> str
 
     d = Digest("true-ortho", [file_identity(paths[i]) for i in relevant], out_crs, list(grid.geotransform))
     d.add([grid.rows, grid.cols])
-    for im in o.images:
-        cam = o.camera_of(im)
-        d.add(
-            [np.asarray(im.R, np.float64), np.asarray(im.C, np.float64), np.asarray(cam.params, np.float64)]
-        )
-    d.add(np.asarray(o.offset, np.float64))
+    d.add(o.to_dict())  # cameras, poses, offset, CRS (as OSGM's key)
     path = getattr(surf, "path", None)
     if path and os.path.isfile(str(path)):
         d.add(file_identity(path))

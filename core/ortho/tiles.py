@@ -45,7 +45,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..grid import RasterGrid, Tile
-from ..parallel import Digest, ProcessLRU, current_cancel, tune_worker_malloc
+from ..parallel import Digest, ProcessLRU, task_cancelled, tune_worker_malloc
 from .color import ColorCorrection
 from .mosaic import ImageStore, MosaicParams, mosaic_tile, to_dtype
 from .surface import PlanTransform
@@ -106,13 +106,10 @@ def worker_store(ctx: OrthoContext) -> ImageStore:
 
 def _threads(ctx: OrthoContext) -> int:
     """Depth-buffer threads: the run's setting, at most the worker's numba threads on a worker."""
-    if ctx.store is not None:
-        return max(1, int(ctx.workers))
-    try:
-        cap = int(os.environ.get("NUMBA_NUM_THREADS", "0"))
-    except ValueError:
-        cap = 0
-    return max(1, min(int(ctx.workers), cap)) if cap > 0 else max(1, int(ctx.workers))
+    cap = os.environ.get("NUMBA_NUM_THREADS", "")
+    if ctx.store is None and cap.isdigit() and int(cap) > 0:
+        return max(1, min(ctx.workers, int(cap)))
+    return max(1, ctx.workers)
 
 
 def ortho_tile_task(ctx: OrthoContext, task: OrthoTask):
@@ -124,8 +121,7 @@ def ortho_tile_task(ctx: OrthoContext, task: OrthoTask):
 
     tune_worker_malloc()
     tile = task.tile
-    cancel = current_cancel()
-    if cancel is not None and cancel():
+    if task_cancelled():
         raise CancelledError("cancelled by the user")
     fixed = np.asarray(task.fixed).astype(np.int64)
     prefer = np.unique(fixed[fixed >= 0])
