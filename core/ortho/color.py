@@ -138,6 +138,29 @@ class ColorCorrection:
             out = np.clip(out, info.min, info.max)
         return out
 
+    def apply_inplace(self, i: int, colours: np.ndarray, mask: np.ndarray, dtype) -> None:
+        """:meth:`apply` to the samples ``colours`` (..., bands) float32 of image ``i`` where ``mask``
+        (the leading shape of ``colours``), in place, in one compiled pass."""
+        if self.is_identity(i):
+            return
+        if colours.dtype != np.float32 or not colours.flags.c_contiguous or mask.shape != colours.shape[:-1]:
+            raise InputError("apply_inplace: colours must be C-contiguous float32 (..., bands) matching the mask")
+        dt = np.dtype(dtype)
+        lo, hi = (float(np.iinfo(dt).min), float(np.iinfo(dt).max)) if dt.kind in "ui" else (-np.inf, np.inf)
+        _correct(
+            colours.reshape(-1, colours.shape[-1]),
+            np.ascontiguousarray(mask).reshape(-1),
+            np.ascontiguousarray(self.gain[i], np.float64),
+            np.ascontiguousarray(self.offset[i], np.float64),
+            bool(self.lab and uses_lab(colours.shape[-1])),
+            value_scale(dt),
+            lo,
+            hi,
+            _M,
+            _M_INV,
+            _WHITE,
+        )
+
     def as_dict(self, names: list[str] | None = None) -> dict:
         rows = []
         for i in range(len(self.gain)):
@@ -153,6 +176,51 @@ class ColorCorrection:
             "images": rows,
             **self.stats,
         }
+
+
+@njit
+def _lab_f(t):
+    d = 6.0 / 29.0
+    return t ** (1.0 / 3.0) if t > d * d * d else t / (3.0 * d * d) + 4.0 / 29.0
+
+
+@njit
+def _lab_finv(f):
+    d = 6.0 / 29.0
+    return f * f * f if f > d else 3.0 * d * d * (f - 4.0 / 29.0)
+
+
+@njit
+def _correct(c, m, gain, offset, lab, scale, lo, hi, M, M_inv, white):
+    """Samples ``c`` (n, bands) float32 where ``m``: the channels of :func:`to_channels` times ``gain``
+    plus ``offset``, back through :func:`from_channels`, clipped to ``[lo, hi]``, in place."""
+    n, B = c.shape
+    lin = np.empty(3)
+    f = np.empty(3)
+    for p in range(n):
+        if not m[p]:
+            continue
+        start = 0
+        if lab:
+            for q in range(3):
+                v = min(max(np.float64(c[p, q]) / scale, 0.0), 1.0)
+                lin[q] = v / 12.92 if v <= 0.04045 else ((v + 0.055) / 1.055) ** 2.4
+            for q in range(3):
+                f[q] = _lab_f((M[q, 0] * lin[0] + M[q, 1] * lin[1] + M[q, 2] * lin[2]) / white[q])
+            L = (116.0 * f[1] - 16.0) * gain[0] + offset[0]
+            A = 500.0 * (f[0] - f[1]) * gain[1] + offset[1]
+            Bb = 200.0 * (f[1] - f[2]) * gain[2] + offset[2]
+            fy = (L + 16.0) / 116.0
+            f[0] = _lab_finv(fy + A / 500.0) * white[0]
+            f[1] = _lab_finv(fy) * white[1]
+            f[2] = _lab_finv(fy - Bb / 200.0) * white[2]
+            for q in range(3):
+                v = min(max(M_inv[q, 0] * f[0] + M_inv[q, 1] * f[1] + M_inv[q, 2] * f[2], 0.0), 1.0)
+                v = 12.92 * v if v <= 0.0031308 else 1.055 * v ** (1.0 / 2.4) - 0.055
+                c[p, q] = min(max(v * scale, lo), hi)
+            start = 3
+        for q in range(start, B):
+            c[p, q] = min(max(np.float64(c[p, q]) * gain[q] + offset[q], lo), hi)
 
 
 def estimate_corrections(

@@ -4,7 +4,8 @@
 cache bounded in bytes, and serves reduced levels (area-averaged halvings) so
 an output cell coarser than the image pixel samples a pixel of about its own
 size instead of aliasing. :func:`sample` reads the colours of a tile's cells
-from one image (bilinear, OpenCV ``remap``), any band count and dtype.
+from one image (bilinear), any band count and dtype; :func:`candidate_colours` samples all
+candidates of a tile in one compiled pass per image.
 
 :func:`mosaic_tile` turns the visibility of a tile (:mod:`.views`) into output
 values: data costs and labels (:mod:`.select`), colours of every candidate
@@ -276,32 +277,65 @@ def candidate_colours(
     res: float,
     needed: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Corrected colours ``(K, rows, cols, bands)`` float32 of every candidate where usable.
+    """Colours ``(K, rows, cols, bands)`` float32 of every candidate where usable (bilinear, border
+    replicated), corrected when ``correction`` is given.
 
     NaN where the candidate is not usable (or not ``needed``).
     """
     K, rows, cols = views.usable.shape
-    out = np.full((K, rows, cols, store.bands), np.nan, np.float32)
+    out = np.empty((K, rows, cols, store.bands), np.float32)
     for k in range(K):
         m = views.usable[k] if needed is None else (views.usable[k] & needed[k])
-        if not m.any():
-            continue
         i = int(views.cands[k])
-        level = store.level_for(float(views.gsd[k]), res)
-        img, origin, lsize = store.source(i, level, views.uv[k][m])
-        kw = {"origin": origin, "level_size": lsize}
-        if m.sum() * 4 < m.size:  # few cells (a late candidate): sample only those
-            col = sample_points(img, views.uv[k][m], level, store.sizes[i], **kw)
-            if correction is not None and not correction.is_identity(i):
-                col = correction.apply(i, col, store.dtype).astype(np.float32)
-            out[k][m] = col
+        if not m.any():
+            out[k] = np.nan
             continue
-        col = sample(img, views.uv[k], level, store.sizes[i], **kw)
-        if correction is not None and not correction.is_identity(i):
-            out[k][m] = correction.apply(i, col[m], store.dtype).astype(np.float32)
-        else:
-            np.copyto(out[k], col, where=m[..., None])
+        level = store.level_for(float(views.gsd[k]), res)
+        uvk = views.uv[k]
+        img, origin, lsize = store.source(i, level, uvk[m] if store.windowed[i] else uvk[:0, 0])
+        W, H = store.sizes[i]
+        _bilinear_into(
+            img.reshape(img.shape[0], img.shape[1], -1),
+            uvk,
+            m,
+            lsize[0] / W,
+            lsize[1] / H,
+            float(origin[0]),
+            float(origin[1]),
+            out[k],
+        )
+        if correction is not None:
+            correction.apply_inplace(i, out[k], m, store.dtype)
     return out
+
+
+@njit
+def _bilinear_into(img, uv, mask, sx, sy, ox, oy, out):
+    """``out[r, c]`` = bilinear sample (border replicated) of ``img`` (h, w, bands) at the
+    full-resolution pixel ``uv[r, c]`` mapped to the level (``x' = (x + 0.5) sx - 0.5``) and
+    shifted by the window origin ``(ox, oy)``; NaN where ``mask`` is False or uv is NaN."""
+    H, W, B = img.shape
+    rows, cols = mask.shape
+    for r in range(rows):
+        for c in range(cols):
+            x = (np.float64(uv[r, c, 0]) + 0.5) * sx - 0.5 - ox
+            y = (np.float64(uv[r, c, 1]) + 0.5) * sy - 0.5 - oy
+            if not mask[r, c] or not (x == x and y == y):
+                for b in range(B):
+                    out[r, c, b] = np.nan
+                continue
+            xf = math.floor(x)
+            yf = math.floor(y)
+            fx = x - xf
+            fy = y - yf
+            i0 = min(max(np.int64(xf), 0), W - 1)
+            i1 = min(max(np.int64(xf) + 1, 0), W - 1)
+            j0 = min(max(np.int64(yf), 0), H - 1)
+            j1 = min(max(np.int64(yf) + 1, 0), H - 1)
+            for b in range(B):
+                top = np.float64(img[j0, i0, b]) * (1.0 - fx) + np.float64(img[j0, i1, b]) * fx
+                bot = np.float64(img[j1, i0, b]) * (1.0 - fx) + np.float64(img[j1, i1, b]) * fx
+                out[r, c, b] = top * (1.0 - fy) + bot * fy
 
 
 @njit
@@ -382,9 +416,7 @@ def mosaic_tile(
     w = feather_weights(labels, clean, params.blend_width)
     if correction is not None:
         for k, i in enumerate(views.cands):
-            m = w[k] > 0
-            if m.any() and not correction.is_identity(int(i)):
-                colours[k][m] = correction.apply(int(i), colours[k][m], store.dtype).astype(np.float32)
+            correction.apply_inplace(int(i), colours[k], w[k] > 0, store.dtype)
     values = np.empty((bands, rows, cols), np.float32)
     _blend(w, colours, values)
     alpha = labels >= 0
