@@ -144,7 +144,7 @@ class ColorCorrection:
         if self.is_identity(i):
             return
         if colours.dtype != np.float32 or not colours.flags.c_contiguous or mask.shape != colours.shape[:-1]:
-            raise InputError("apply_inplace: colours must be C-contiguous float32 (..., bands) matching the mask")
+            raise InputError("apply_inplace: colours must be C-contiguous float32 (..., bands) like the mask")
         dt = np.dtype(dtype)
         lo, hi = (float(np.iinfo(dt).min), float(np.iinfo(dt).max)) if dt.kind in "ui" else (-np.inf, np.inf)
         _correct(

@@ -3,9 +3,8 @@
 :class:`ImageStore` decodes source images on demand, keeps a least-recently-used
 cache bounded in bytes, and serves reduced levels (area-averaged halvings) so
 an output cell coarser than the image pixel samples a pixel of about its own
-size instead of aliasing. :func:`sample` reads the colours of a tile's cells
-from one image (bilinear), any band count and dtype; :func:`candidate_colours` samples all
-candidates of a tile in one compiled pass per image.
+size instead of aliasing. :func:`candidate_colours` reads the colours of a tile's cells
+from every candidate image (bilinear, one compiled pass per image), any band count and dtype.
 
 :func:`mosaic_tile` turns the visibility of a tile (:mod:`.views`) into output
 values: data costs and labels (:mod:`.select`), colours of every candidate
@@ -167,58 +166,6 @@ class ImageStore:
         if not (gsd > 0 and res > 0):
             return 0
         return max(0, min(8, int(math.floor(math.log2(res / gsd) + 1e-9))))
-
-
-def sample(
-    img: np.ndarray,
-    uv: np.ndarray,
-    level: int,
-    full_size: tuple[int, int],
-    origin: tuple[int, int] = (0, 0),
-    level_size: tuple[int, int] | None = None,
-) -> np.ndarray:
-    """Bilinear samples ``(rows, cols, bands)`` float32 at full-resolution pixel coordinates ``uv``.
-
-    ``uv``: (rows, cols, 2) float32, NaN where not needed (sampled as 0).
-    At ``level`` > 0 coordinates map as ``x' = (x + 0.5) * w'/w - 0.5``. ``img`` may be a window
-    of the level image: ``origin`` its first pixel (x, y), ``level_size`` the level's (w', h').
-    """
-    import cv2
-
-    h, w = img.shape[:2] if level_size is None else (level_size[1], level_size[0])
-    W, H = full_size
-    sx, sy = w / W, h / H
-    mx = ((uv[..., 0] + 0.5) * sx - 0.5 - origin[0]).astype(np.float32)
-    my = ((uv[..., 1] + 0.5) * sy - 0.5 - origin[1]).astype(np.float32)
-    bad = ~(np.isfinite(mx) & np.isfinite(my))
-    mx[bad] = -10.0
-    my[bad] = -10.0
-    src = img if img.dtype in (np.uint8, np.uint16, np.int16, np.float32) else img.astype(np.float32)
-    chans = (
-        [src]
-        if src.ndim == 2
-        else ([src] if src.shape[2] <= 4 else [src[:, :, c] for c in range(src.shape[2])])
-    )
-    outs = []
-    for ch in chans:
-        o = cv2.remap(ch, mx, my, interpolation=cv2.INTER_LINEAR, borderMode=cv2.BORDER_REPLICATE)
-        if o.ndim == 2:
-            o = o[:, :, None]
-        outs.append(o.astype(np.float32))
-    return np.concatenate(outs, axis=2) if len(outs) > 1 else outs[0]
-
-
-def sample_points(
-    img: np.ndarray, uv: np.ndarray, level: int, full_size: tuple[int, int], **kw
-) -> np.ndarray:
-    """:func:`sample` of ``(n, 2)`` points: ``(n, bands)`` float32 (OpenCV maps are at most 32767 wide)."""
-    n = len(uv)
-    width = 1024
-    rows = max(1, -(-n // width))
-    pad = np.full((rows * width, 2), np.nan, np.float32)
-    pad[:n] = uv
-    out = sample(img, pad.reshape(rows, width, 2), level, full_size, **kw)
-    return out.reshape(rows * width, -1)[:n]
 
 
 def luminance01(col: np.ndarray, dtype) -> np.ndarray:
