@@ -18,6 +18,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..jit import njit
 
 
 def feather_weights(labels: np.ndarray, clean: np.ndarray, width: int) -> np.ndarray:
@@ -34,25 +35,47 @@ def feather_weights(labels: np.ndarray, clean: np.ndarray, width: int) -> np.nda
     import cv2
 
     K = clean.shape[0]
-    lab = np.asarray(labels)
+    lab = np.ascontiguousarray(labels, dtype=np.int64)
     if lab.shape != clean.shape[1:]:
         raise InputError("feather_weights: labels and visibility differ in shape")
     out = np.zeros(clean.shape, np.float32)
-    has = lab >= 0
     half = max(int(width) // 2, 0)
-    for k in range(K):
-        ind = (lab == k).astype(np.float32)
-        if half > 0 and ind.any():
-            w = cv2.blur(ind, (2 * half + 1, 2 * half + 1), borderType=cv2.BORDER_REFLECT)
-            w = np.where(clean[k], w, 0.0)
-        else:
-            w = np.zeros_like(ind)
-        w = np.where(lab == k, np.maximum(w, 1e-3), w)
-        out[k] = w
-    s = out.sum(axis=0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        out = np.where(has[None], out / np.where(s > 0, s, 1.0)[None], 0.0).astype(np.float32)
+    if half > 0:
+        present = np.zeros(K + 1, bool)
+        present[np.clip(lab, -1, K - 1).ravel() + 1] = True
+        for k in np.flatnonzero(present[1:]):
+            # share of the window labelled k (box filter of the indicator)
+            cv2.blur(
+                (lab == k).astype(np.float32),
+                (2 * half + 1, 2 * half + 1),
+                dst=out[k],
+                borderType=cv2.BORDER_REFLECT,
+            )
+    _feather_finish(lab, np.ascontiguousarray(clean), out)
     return out
+
+
+@njit
+def _feather_finish(lab, clean, w):
+    """Weights ``w`` (K, rows, cols) kept where the image sees the cell cleanly, the cell's own label at
+    least 1e-3, normalised to sum 1 over k; 0 where the cell has no label."""
+    K, rows, cols = w.shape
+    for r in range(rows):
+        for c in range(cols):
+            lb = lab[r, c]
+            if lb < 0 or lb >= K:
+                for k in range(K):
+                    w[k, r, c] = 0.0
+                continue
+            s = np.float32(0.0)
+            for k in range(K):
+                v = w[k, r, c] if clean[k, r, c] else np.float32(0.0)
+                if k == lb and v < 1e-3:
+                    v = np.float32(1e-3)
+                w[k, r, c] = v
+                s += v
+            for k in range(K):
+                w[k, r, c] = w[k, r, c] / s
 
 
 def region_polygons(index: np.ndarray, transform) -> dict[int, list]:

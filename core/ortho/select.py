@@ -129,12 +129,13 @@ def initial_labels(
     fixed cells keep their label.
     """
     K, rows, cols = cost.shape
-    finite = np.isfinite(cost)
-    any_vis = finite.any(axis=0)
-    lab = np.where(any_vis, np.argmin(np.where(finite, cost, np.inf), axis=0), NO_LABEL).astype(np.int32)
+    cost = np.ascontiguousarray(cost, np.float32)
+    lab = np.empty((rows, cols), np.int32)
+    _best_label(cost, lab)
+    any_vis = lab >= 0
     if fixed is not None:
         fx = np.asarray(fixed)
-        fixed_ok = (fx >= 0) & np.take_along_axis(finite, np.clip(fx, 0, K - 1)[None], axis=0)[0]
+        fixed_ok = (fx >= 0) & np.isfinite(np.take_along_axis(cost, np.clip(fx, 0, K - 1)[None], axis=0)[0])
     if K < 2:
         return lab
     seg = segments(h, step)
@@ -154,16 +155,10 @@ def initial_labels(
     small[border] &= size[border] <= 0.25 * rows * cols
     if not small.any():
         return lab
-    cand = small[s]
-    sid = s[cand]
     # per segment and image: cells seen and summed cost
     seen = np.zeros((K, nseg))
     total = np.zeros((K, nseg))
-    for k in range(K):
-        f = finite[k][valid][cand]
-        seen[k] = np.bincount(sid, weights=f.astype(np.float64), minlength=nseg)
-        c = cost[k][valid][cand]
-        total[k] = np.bincount(sid, weights=np.where(f, c, 0.0), minlength=nseg)
+    _segment_sums(cost, seg, small, seen, total)
     cover = seen / np.maximum(size[None, :], 1)
     score = np.where(cover >= segment_cover, total / np.maximum(seen, 1) + (1.0 - cover) * 10.0, np.inf)
     if fixed is not None and fixed_ok.any():
@@ -184,11 +179,43 @@ def initial_labels(
     full[valid] = seg_label[seg[valid]]
     take = (full >= 0) & any_vis
     kk = np.clip(full, 0, K - 1)
-    ok = take & np.take_along_axis(finite, kk[None], axis=0)[0]
+    ok = take & np.isfinite(np.take_along_axis(cost, kk[None], axis=0)[0])
     lab[ok] = full[ok]
     if fixed is not None:
         lab[fixed_ok] = np.asarray(fixed)[fixed_ok]
     return lab
+
+
+@njit
+def _best_label(cost, out):
+    """``out[r, c]``: the first k of smallest finite ``cost[k, r, c]``, -1 where none is finite."""
+    K, rows, cols = cost.shape
+    for r in range(rows):
+        for c in range(cols):
+            best = np.inf
+            lab = NO_LABEL
+            for k in range(K):
+                v = cost[k, r, c]
+                if v < best:
+                    best = v
+                    lab = k
+            out[r, c] = lab
+
+
+@njit
+def _segment_sums(cost, seg, small, seen, total):
+    """Per small segment s and image k: cells of s with a finite cost of k, and their summed cost."""
+    K, rows, cols = cost.shape
+    for r in range(rows):
+        for c in range(cols):
+            s = seg[r, c]
+            if s < 0 or not small[s]:
+                continue
+            for k in range(K):
+                v = cost[k, r, c]
+                if v < np.inf:
+                    seen[k, s] += 1.0
+                    total[k, s] += v
 
 
 @njit
