@@ -224,18 +224,18 @@ def _pair_cost(a, b, r0, c0, r1, c1, w, lum, contrast):
     if a == b:
         return 0.0
     d = 0.0
-    la = lum[r0, c0, a]
-    lb = lum[r0, c0, b]
+    la = lum[a, r0, c0]
+    lb = lum[b, r0, c0]
     d += abs(la - lb) if (la == la and lb == lb) else 1.0
-    la = lum[r1, c1, a]
-    lb = lum[r1, c1, b]
+    la = lum[a, r1, c1]
+    lb = lum[b, r1, c1]
     d += abs(la - lb) if (la == la and lb == lb) else 1.0
     return w * (1.0 + contrast * d)
 
 
 @njit
 def _local_energy(k, r, c, labels, cost, lum, wh, wv, smooth, contrast, rows, cols):
-    e = cost[r, c, k]
+    e = cost[k, r, c]
     if c > 0:
         q = labels[r, c - 1]
         if q >= 0:
@@ -257,13 +257,13 @@ def _local_energy(k, r, c, labels, cost, lum, wh, wv, smooth, contrast, rows, co
 
 @njit
 def _icm(labels, frozen, cost, lum, wh, wv, smooth, contrast, sweeps):
-    """ICM sweeps; ``cost`` and ``lum`` are (rows, cols, K) (cell-major for locality).
+    """ICM sweeps; ``cost`` and ``lum`` are (K, rows, cols).
 
     The labels tried at a cell are its current one, its data-best one and those of
     its four neighbours: any other label pays a seam to every neighbour for no gain
     in the data term.
     """
-    K = cost.shape[2]
+    K = cost.shape[0]
     rows = labels.shape[0]
     cols = labels.shape[1]
     best_data = np.full((rows, cols), -1, np.int64)
@@ -276,7 +276,7 @@ def _icm(labels, frozen, cost, lum, wh, wv, smooth, contrast, sweeps):
             bd = -1
             bv = np.inf
             for k in range(K):
-                v = cost[r, c, k]
+                v = cost[k, r, c]
                 if v < np.inf:
                     n += 1
                     if v < bv:
@@ -311,7 +311,7 @@ def _icm(labels, frozen, cost, lum, wh, wv, smooth, contrast, sweeps):
                 best_e = _local_energy(cur, r, c, labels, cost, lum, wh, wv, smooth, contrast, rows, cols)
                 for m in range(1, 6):
                     k = cand[m]
-                    if k < 0 or k == cur or not cost[r, c, k] < np.inf:
+                    if k < 0 or k == cur or not cost[k, r, c] < np.inf:
                         continue
                     seen_before = False
                     for mm in range(1, m):
@@ -387,8 +387,8 @@ def select_labels(
     _icm(
         labels,
         frozen,
-        np.ascontiguousarray(np.moveaxis(cost, 0, -1), dtype=np.float32),
-        np.ascontiguousarray(np.moveaxis(lum, 0, -1), dtype=np.float32),
+        np.ascontiguousarray(cost, dtype=np.float32),
+        np.ascontiguousarray(lum, dtype=np.float32),
         wh,
         wv,
         float(smoothness),

@@ -38,7 +38,7 @@ from ..geometry.camera import Camera
 from ..grid import RasterGrid, Tile
 from ..jit import njit
 from .surface import PlanTransform
-from .zbuffer import frame_cells, project, render_depth, view_cells
+from .zbuffer import frame_cells, project, render_depth, view_cells_into
 
 #: Candidates evaluated between two checks of the cells' clean views (``views_per_cell``).
 LAZY_BATCH = 2
@@ -396,9 +396,10 @@ def tile_views(
     # colour sample points: cells next to a height discontinuity are sampled a little inside their own
     # side, so the bilinear sample does not mix in the other side of a building outline
     S = P
+    moved_flat = np.zeros(len(P), np.bool_)
     if setup.edge_shift > 0:
         ex, ey = edge_shift(h, setup.discontinuity)
-        moved = (ex != 0) | (ey != 0)
+        moved = ((ex != 0) | (ey != 0)) & valid
         if moved.any():
             delta = setup.edge_shift * res
             sx, sy = X + delta * ex, Y + delta * ey
@@ -412,36 +413,53 @@ def tile_views(
             S = P.copy()
             mi = np.flatnonzero(moved.ravel())
             S[mi, 0], S[mi, 1], S[mi, 2] = slx, sly, sz
+            moved_flat[mi] = True
 
     vidx = np.flatnonzero(vflat)
+    # candidates in order of their resolution over the tile; with ``views_per_cell`` a cell stops
+    # taking further candidates once that many see it cleanly (the later ones run only on the rest)
+    order = cand_all[np.argsort(_tile_scores(setup, cand_all, vidx, P), kind="stable")]
+    if prefer is not None and len(prefer):
+        first = np.isin(order, np.asarray(prefer))
+        order = np.concatenate([order[first], order[~first]])
+    # one row per candidate (in image order) of the per-cell results, written by the fused passes
+    cand_sorted = np.sort(order)
+    row_of = {int(k): r for r, k in enumerate(cand_sorted)}
+    Kc, n = len(cand_sorted), rows * cols
+    usable = np.zeros((Kc, n), np.bool_)
+    edge = np.zeros((Kc, n), np.bool_)
+    uv = np.full((Kc, n, 2), np.nan, np.float32)
+    eff = np.full((Kc, n), np.inf, np.float32)
+    counts = np.zeros(Kc, np.int64)
+    gsd_all = np.zeros(Kc)
 
     def one(k, cells):
         im = setup.images[k]
         cam = setup.cameras[k]
-        sub, uvp, dist = frame_cells(P, im.R, im.C, cam, setup.max_view, index=cells)
-        if not len(sub):
-            return None
-        idx = cells[sub]
+        r = row_of[int(k)]
+        fc = frame_cells(P, im.R, im.C, cam, setup.max_view, index=cells)
+        if not len(fc):
+            return
         # median distance from a regular subsample (the buffer scale and image level need no more)
-        gsd = float(np.median(dist[:: max(1, len(dist) // 4096)])) / cam.fx
+        gsd = float(np.median(fc.dist[:: max(1, len(fc) // 4096)])) / cam.fx
         scale = min(1.0, setup.oversample * gsd / res) if setup.visibility else 1.0
         zb = win = None
         if setup.visibility:
-            uvb = (uvp + 0.5) * scale - 0.5
             bw = max(1, int(round(cam.width * scale)))
             bh = max(1, int(round(cam.height * scale)))
-            x0 = max(int(math.floor(uvb[:, 0].min())) - 2, 0)
-            y0 = max(int(math.floor(uvb[:, 1].min())) - 2, 0)
-            x1 = min(int(math.ceil(uvb[:, 0].max())) + 2, bw - 1)
-            y1 = min(int(math.ceil(uvb[:, 1].max())) + 2, bh - 1)
+            x0 = max(int(math.floor((float(fc.u.min()) + 0.5) * scale - 0.5)) - 2, 0)
+            y0 = max(int(math.floor((float(fc.v.min()) + 0.5) * scale - 0.5)) - 2, 0)
+            x1 = min(int(math.ceil((float(fc.u.max()) + 0.5) * scale - 0.5)) + 2, bw - 1)
+            y1 = min(int(math.ceil((float(fc.v.max()) + 0.5) * scale - 0.5)) + 2, bh - 1)
             win = (x0, y0, x1 - x0 + 1, y1 - y0 + 1)
             zb = render_depth(tris, im.R, im.C, cam, win, scale)
         # one fused pass: depth test, near-occluder test, incidence, effective resolution, sample
         # coordinates (the nearest pixel next to an occluder instead of a bilinear mix with it)
-        good, ne, uvk, eff = view_cells(
-            idx,
+        counts[r] = view_cells_into(
+            fc,
             P,
             S,
+            moved_flat,
             normals,
             im.R,
             im.C,
@@ -450,20 +468,14 @@ def tile_views(
             win,
             scale,
             res,
+            (usable[r], edge[r], uv[r], eff[r]),
             setup.tol_factor,
             setup.visibility,
         )
-        return idx[good], ne[good], uvk[good], eff[good], gsd
+        gsd_all[r] = gsd
 
-    # candidates in order of their resolution over the tile; with ``views_per_cell`` a cell stops
-    # taking further candidates once that many see it cleanly (the later ones run only on the rest)
-    order = cand_all[np.argsort(_tile_scores(setup, cand_all, vidx, P), kind="stable")]
-    if prefer is not None and len(prefer):
-        first = np.isin(order, np.asarray(prefer))
-        order = np.concatenate([order[first], order[~first]])
-    clean_count = np.zeros(rows * cols, np.int32)
+    clean_count = np.zeros(n, np.int32)
     cells = vidx
-    results_by: dict[int, tuple | None] = {}
     # lazy: fixed batches, so the result does not depend on the threads; else all in one batch
     batch = LAZY_BATCH if setup.views_per_cell > 0 else max(len(order), 1)
     pool = None
@@ -475,43 +487,33 @@ def tile_views(
         for b0 in range(0, len(order), batch):
             ks = order[b0 : b0 + batch]
             if pool is not None and len(ks) > 1:
-                res_b = list(pool.map(one, ks, [cells] * len(ks)))
+                list(pool.map(one, ks, [cells] * len(ks)))
             else:
-                res_b = [one(k, cells) for k in ks]
-            for k, r in zip(ks, res_b, strict=True):
-                results_by[int(k)] = r
-                if r is not None and setup.views_per_cell > 0:
-                    clean_count[r[0][~r[1]]] += 1
+                for k in ks:
+                    one(k, cells)
             if setup.views_per_cell > 0:
+                for k in ks:
+                    r = row_of[int(k)]
+                    if counts[r]:
+                        clean_count += usable[r] & ~edge[r]
                 cells = cells[clean_count[cells] < setup.views_per_cell]
                 if not len(cells):
                     break
     finally:
         if pool is not None:
             pool.shutdown()
-    cand_all = np.array(sorted(results_by), np.int64)
-    results: list = [results_by[int(k)] for k in cand_all]
-    keep = [i for i, r in enumerate(results) if r is not None and len(r[0])]
-    if not keep:
+    keep = np.flatnonzero(counts > 0)
+    if not len(keep):
         return empty
+    if len(keep) < Kc:
+        usable, edge, uv, eff = usable[keep], edge[keep], uv[keep], eff[keep]
     K = len(keep)
-    n = rows * cols
-    usable = np.zeros((K, n), bool)
-    edge = np.zeros((K, n), bool)
-    uv = np.full((K, n, 2), np.nan, np.float32)
-    eff = np.full((K, n), np.inf, np.float32)
-    for k, i in enumerate(keep):
-        gi, ne, uvk, ek, _ = results[i]
-        usable[k, gi] = True
-        edge[k, gi] = ne
-        uv[k, gi] = uvk
-        eff[k, gi] = ek
     usable = usable.reshape(K, rows, cols)
     edge = edge.reshape(K, rows, cols)
     uv = uv.reshape(K, rows, cols, 2)
     eff = eff.reshape(K, rows, cols)
-    gsd = np.array([results[i][4] for i in keep])
-    cands = cand_all[keep]
+    gsd = gsd_all[keep]
+    cands = cand_sorted[keep]
     if setup.top_views > 0 and K > setup.top_views:
         # candidates among the best ``top_views`` of no cell are dropped: a cell starts from its best
         # image (or its roof's), and a seam move only takes a neighbour's label; kept are also the

@@ -533,11 +533,12 @@ def depth_tolerance(res: float, pixel_footprint, tan_view, factor: float = 1.0, 
 
 
 @njit
-def _frame_pass(P, index, R, C, p, r2max, width, height, cos_max, u_out, v_out, dist_out):
-    """Points ``P[index[i]]`` in front, inside the frame and within the viewing angle: 1, else 0."""
-    n = index.shape[0]
-    ok = np.zeros(n, np.uint8)
-    for i in range(n):
+def _frame_pass(P, index, R, C, p, r2max, width, height, cos_max, cell_out, u_out, v_out, z_out, dist_out):
+    """Compacts the points ``P[index[i]]`` in front, inside the frame and within the viewing angle:
+    their index into ``P``, full-resolution pixel ``(u, v)``, camera depth and distance go to the
+    first ``m`` entries of the outputs, in the order of ``index``; returns ``m``."""
+    m = 0
+    for i in range(index.shape[0]):
         j = index[i]
         dx = C[0] - P[j, 0]
         dy = C[1] - P[j, 1]
@@ -548,23 +549,29 @@ def _frame_pass(P, index, R, C, p, r2max, width, height, cos_max, u_out, v_out, 
         u, v, z = _proj(P[j, 0], P[j, 1], P[j, 2], R, C, p, r2max)
         if z <= 0.0 or u < -0.5 or v < -0.5 or u > width - 0.5 or v > height - 0.5:
             continue
-        ok[i] = 1
-        u_out[i] = u
-        v_out[i] = v
-        dist_out[i] = dist
-    return ok
+        cell_out[m] = j
+        u_out[m] = u
+        v_out[m] = v
+        z_out[m] = z
+        dist_out[m] = dist
+        m += 1
+    return m
 
 
 @njit
 def _view_pass(
-    idx,
+    cells,
+    us,
+    vs,
+    zs,
+    dists,
     P,
     S,
+    moved,
     normals,
     R,
     C,
     p_full,
-    p_buf,
     r2max,
     scale,
     res,
@@ -574,39 +581,39 @@ def _view_pass(
     x0,
     y0,
     use_vis,
-    good,
+    usable,
     edge,
-    us,
-    vs,
+    uv,
     eff,
 ):
-    """Depth test (optional), incidence, effective resolution and sample coordinates of cells.
+    """Depth test (optional), incidence, effective resolution and sample coordinates of the cells of
+    :func:`_frame_pass` (``cells`` with their pixel ``us, vs``, depth ``zs``, distance ``dists``),
+    written at each cell's index into ``usable, edge, uv, eff`` (N,) / (N, 2); returns the usable count.
 
-    ``P`` surface points, ``S`` colour sample points, ``normals`` unit normals, all (N, 3);
-    the cells ``idx`` (n,) are processed, outputs (n,) in that order.
-    Tolerance as :func:`depth_tolerance`; ``zbuf`` window origin ``(x0, y0)`` in buffer pixels.
+    ``P`` surface points, ``S`` colour sample points (projected only where ``moved``, elsewhere
+    ``S`` = ``P``), ``normals`` unit normals, all (N, 3). The buffer pixel of a cell is its image
+    pixel at ``scale`` (``x' = (x + 0.5) scale - 0.5``), the buffer window's origin ``(x0, y0)``.
+    Tolerance as :func:`depth_tolerance`.
     """
     H = zbuf.shape[0]
     W = zbuf.shape[1]
     fx = p_full[0]
-    for m in range(idx.shape[0]):
-        n = idx[m]
-        good[m] = 0
-        edge[m] = 0
+    count = 0
+    for m in range(cells.shape[0]):
+        n = cells[m]
+        dist = dists[m]
         dx = C[0] - P[n, 0]
         dy = C[1] - P[n, 1]
         dz = C[2] - P[n, 2]
-        dist = math.sqrt(dx * dx + dy * dy + dz * dz)
         cos_view = dz / dist
         cos_inc = (normals[n, 0] * dx + normals[n, 1] * dy + normals[n, 2] * dz) / dist
         if cos_inc <= min_cos_inc or cos_view <= 1e-6:
             continue
+        near = False
         if use_vis:
-            u, v, z = _proj(P[n, 0], P[n, 1], P[n, 2], R, C, p_buf, r2max)
-            if z <= 0.0:
-                continue
-            i = np.int64(math.floor(u - x0 + 0.5))
-            j = np.int64(math.floor(v - y0 + 0.5))
+            z = zs[m]
+            i = np.int64(math.floor((us[m] + 0.5) * scale - 0.5 - x0 + 0.5))
+            j = np.int64(math.floor((vs[m] + 0.5) * scale - 0.5 - y0 + 0.5))
             if i < 0 or j < 0 or i >= W or j >= H:
                 continue
             tan_view = math.sqrt(max(1.0 - cos_view * cos_view, 0.0)) / cos_view
@@ -621,36 +628,53 @@ def _view_pass(
                 for ii in range(max(i - 1, 0), min(i + 2, W)):
                     if zbuf[jj, ii] < zmin:
                         zmin = zbuf[jj, ii]
-            if zmin < z - t:
-                edge[m] = 1
-        su, sv, sz = _proj(S[n, 0], S[n, 1], S[n, 2], R, C, p_full, r2max)
-        if sz <= 0.0:
-            edge[m] = 0
-            continue
-        if edge[m]:
+            near = zmin < z - t
+        if moved[n]:
+            su, sv, sz = _proj(S[n, 0], S[n, 1], S[n, 2], R, C, p_full, r2max)
+            if sz <= 0.0:
+                continue
+        else:
+            su = us[m]
+            sv = vs[m]
+        if near:
             su = math.floor(su + 0.5)
             sv = math.floor(sv + 0.5)
-        good[m] = 1
-        us[m] = su
-        vs[m] = sv
-        eff[m] = dist / (fx * cos_inc)
+        usable[n] = True
+        edge[n] = near
+        uv[n, 0] = su
+        uv[n, 1] = sv
+        eff[n] = dist / (fx * cos_inc)
+        count += 1
+    return count
 
 
-def frame_cells(points, R, C, camera: Camera, max_view_rad: float, index=None):
+@dataclass
+class FrameCells:
+    """Cells of :func:`frame_cells` (compact, in the order of the index given): index into the
+    points, full-resolution pixel ``u, v``, camera depth ``z`` and distance (metres)."""
+
+    cells: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    z: np.ndarray
+    dist: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.cells)
+
+
+def frame_cells(points, R, C, camera: Camera, max_view_rad: float, index=None) -> FrameCells:
     """Cells seen inside the frame, in front, within the viewing angle.
 
-    ``index`` (optional): the rows of ``points`` to test (default all).
-    Returns ``(index (m,) int, uv (m, 2) float64 full-resolution pixels, distance (m,) metres)``;
-    the returned index counts in ``index`` when given (positions in it), else in ``points``.
+    ``points`` (N, 3) local; ``index`` (optional): the rows of ``points`` to test (default all).
     """
     Rm, Cv = _pose(R, C)
     P = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
     ix = np.arange(len(P)) if index is None else np.ascontiguousarray(np.asarray(index, dtype=np.int64))
     n = len(ix)
-    u = np.empty(n)
-    v = np.empty(n)
-    d = np.empty(n)
-    ok = _frame_pass(
+    cells = np.empty(n, np.int64)
+    u, v, z, d = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
+    m = _frame_pass(
         P,
         ix,
         Rm,
@@ -660,18 +684,20 @@ def frame_cells(points, R, C, camera: Camera, max_view_rad: float, index=None):
         float(camera.width),
         float(camera.height),
         math.cos(max_view_rad),
+        cells,
         u,
         v,
+        z,
         d,
     )
-    idx = np.flatnonzero(ok)
-    return idx, np.column_stack([u[idx], v[idx]]), d[idx]
+    return FrameCells(cells[:m], u[:m], v[:m], z[:m], d[:m])
 
 
-def view_cells(
-    idx,
+def view_cells_into(
+    fc: FrameCells,
     points,
     samples,
+    moved,
     normals,
     R,
     C,
@@ -680,71 +706,65 @@ def view_cells(
     window,
     scale: float,
     res: float,
+    out: tuple,
     tol_factor: float = 1.0,
     visibility: bool = True,
     min_cos_inc: float = 0.02,
-):
-    """Per-cell result of one image in one pass (:func:`point_visibility` + incidence + sampling).
+) -> int:
+    """Per-cell result of one image in one pass (the depth test of :func:`point_visibility` +
+    incidence + sampling) for the cells of :func:`frame_cells`.
 
     Parameters
     ----------
-    idx : (n,) int
-        The cells to process (rows of the arrays below).
+    fc : FrameCells
     points, samples, normals : (N, 3) float64, C-contiguous
         Surface points, colour sample points (local frame) and unit surface normals.
+    moved : (N,) bool
+        Where ``samples`` differs from ``points``.
     zbuf, window, scale : the depth buffer of :func:`render_depth` (ignored without ``visibility``).
+    out : (usable (N,) bool, near_edge (N,) bool, uv (N, 2) float32, eff (N,) float32)
+        Written at the cells found usable (visible when tested, facing the camera, sample point in
+        front): near an occlusion edge, full-resolution sample coordinates (rounded to the pixel
+        centre next to an occluder), effective ground resolution ``distance / (fx cos incidence)``.
 
     Returns
     -------
-    good : (n,) bool
-        Visible (when tested), facing the camera and projecting in front.
-    near_edge : (n,) bool
-    uv : (n, 2) float32
-        Full-resolution sample coordinates (rounded to the pixel centre next to an occluder).
-    eff : (n,) float32
-        Effective ground resolution ``distance / (fx cos incidence)``, metres.
+    int : the cells found usable.
     """
     Rm, Cv = _pose(R, C)
-    ix = np.ascontiguousarray(np.asarray(idx, dtype=np.int64))
-    P = np.ascontiguousarray(np.asarray(points, dtype=np.float64))
-    Sm = np.ascontiguousarray(np.asarray(samples, dtype=np.float64))
-    N = np.ascontiguousarray(np.asarray(normals, dtype=np.float64))
-    if not (P.shape == Sm.shape == N.shape and P.ndim == 2 and P.shape[1] == 3):
-        raise InputError("view_cells: points, samples and normals must be (N, 3) arrays of one shape")
-    if len(ix) and (ix.min() < 0 or ix.max() >= len(P)):
-        raise InputError("view_cells: cell index out of range")
-    n = len(ix)
+    P, Sm, N = points, samples, normals
+    if not (P.shape == Sm.shape == N.shape and P.ndim == 2 and P.shape[1] == 3 and moved.shape == (len(P),)):
+        raise InputError("view_cells_into: points, samples and normals must be (N, 3) arrays of one shape")
+    usable, edge, uv, eff = out
     if zbuf is None:
         zbuf = np.full((1, 1), np.inf, np.float32)
         window = (0, 0, 1, 1)
-    good = np.empty(n, np.uint8)
-    edge = np.empty(n, np.uint8)
-    us = np.full(n, np.nan)
-    vs = np.full(n, np.nan)
-    eff = np.full(n, np.inf)
-    _view_pass(
-        ix,
-        P,
-        Sm,
-        N,
-        Rm,
-        Cv,
-        camera.params,
-        scaled_params(camera, scale),
-        valid_radius2(camera),
-        float(scale),
-        float(res),
-        float(tol_factor),
-        float(min_cos_inc),
-        zbuf,
-        float(window[0]),
-        float(window[1]),
-        bool(visibility),
-        good,
-        edge,
-        us,
-        vs,
-        eff,
+    return int(
+        _view_pass(
+            fc.cells,
+            fc.u,
+            fc.v,
+            fc.z,
+            fc.dist,
+            P,
+            Sm,
+            moved,
+            N,
+            Rm,
+            Cv,
+            camera.params,
+            valid_radius2(camera),
+            float(scale),
+            float(res),
+            float(tol_factor),
+            float(min_cos_inc),
+            zbuf,
+            float(window[0]),
+            float(window[1]),
+            bool(visibility),
+            usable,
+            edge,
+            uv,
+            eff,
+        )
     )
-    g = good.astype(bool)
-    return g, edge.astype(bool) & g, np.column_stack([us, vs]).astype(np.float32), eff.astype(np.float32)
