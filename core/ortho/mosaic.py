@@ -223,20 +223,22 @@ def candidate_colours(
     correction: ColorCorrection | None,
     res: float,
     needed: np.ndarray | None = None,
+    workers: int = 1,
 ) -> np.ndarray:
     """Colours ``(K, rows, cols, bands)`` float32 of every candidate where usable (bilinear, border
     replicated), corrected when ``correction`` is given.
 
-    NaN where the candidate is not usable (or not ``needed``).
+    NaN where the candidate is not usable (or not ``needed``). Images run in ``workers`` threads.
     """
     K, rows, cols = views.usable.shape
     out = np.empty((K, rows, cols, store.bands), np.float32)
-    for k in range(K):
+
+    def one(k):
         m = views.usable[k] if needed is None else (views.usable[k] & needed[k])
         i = int(views.cands[k])
         if not m.any():
             out[k] = np.nan
-            continue
+            return
         level = store.level_for(float(views.gsd[k]), res)
         uvk = views.uv[k]
         img, origin, lsize = store.source(i, level, uvk[m] if store.windowed[i] else uvk[:0, 0])
@@ -253,7 +255,22 @@ def candidate_colours(
         )
         if correction is not None:
             correction.apply_inplace(i, out[k], m, store.dtype)
+
+    each(one, range(K), workers)
     return out
+
+
+def each(fn, items, workers: int = 1) -> None:
+    """``fn(item)`` for every item, in ``workers`` threads when > 1 (compiled kernels release the GIL)."""
+    items = list(items)
+    if workers > 1 and len(items) > 1:
+        from concurrent.futures import ThreadPoolExecutor
+
+        with ThreadPoolExecutor(max_workers=min(workers, len(items))) as pool:
+            list(pool.map(fn, items))
+    else:
+        for it in items:
+            fn(it)
 
 
 @njit
@@ -310,11 +327,13 @@ def mosaic_tile(
     res: float,
     params: MosaicParams,
     fixed: np.ndarray | None = None,
+    workers: int = 1,
 ) -> TileMosaic:
     """Labels, blended colours, alpha and occlusion of a tile's outer window.
 
     ``fixed``: (rows, cols) global image indices already written by neighbouring
-    tiles (-1 = free), continued here (:func:`~.select.select_labels`).
+    tiles (-1 = free), continued here (:func:`~.select.select_labels`). Per-image sampling and
+    correction run in ``workers`` threads.
     """
     rows, cols = views.heights.shape
     valid = np.isfinite(views.heights)
@@ -335,7 +354,7 @@ def mosaic_tile(
     # raw colours of every candidate; the seam cost uses their luminance corrected by the
     # lightness (or first band) gain and offset, the full correction is applied below only to
     # the samples that enter the mosaic
-    colours = candidate_colours(views, store, None, res)
+    colours = candidate_colours(views, store, None, res, workers=workers)
     lum = luminance01(colours, store.dtype)
     if correction is not None:
         for k, i in enumerate(views.cands):
@@ -362,8 +381,11 @@ def mosaic_tile(
     clean = usable & ~views.near_edge
     w = feather_weights(labels, clean, params.blend_width)
     if correction is not None:
-        for k, i in enumerate(views.cands):
-            correction.apply_inplace(int(i), colours[k], w[k] > 0, store.dtype)
+        each(
+            lambda k: correction.apply_inplace(int(views.cands[k]), colours[k], w[k] > 0, store.dtype),
+            range(K),
+            workers,
+        )
     values = np.empty((bands, rows, cols), np.float32)
     _blend(w, colours, values)
     alpha = labels >= 0

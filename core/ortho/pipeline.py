@@ -669,7 +669,7 @@ def _estimate_colour(
             clean = views.usable & ~views.near_edge & np.isfinite(views.heights)[None]
             multi = clean.sum(axis=0) >= 2
             need = clean & multi[None]
-            col = candidate_colours(views, store, None, g.res, need)
+            col = candidate_colours(views, store, None, g.res, need, workers)
             r0, c0 = tile.outer[0], tile.outer[1]
             rr, cc = np.nonzero(multi)
             cid = (rr + r0) * g.cols + (cc + c0)

@@ -125,11 +125,12 @@ def ortho_tile_task(ctx: OrthoContext, task: OrthoTask):
         raise CancelledError("cancelled by the user")
     fixed = np.asarray(task.fixed).astype(np.int64)
     prefer = np.unique(fixed[fixed >= 0])
-    views = tile_views(ctx.setup, ctx.surface, ctx.grid, tile, ctx.to_local, _threads(ctx), prefer=prefer)
+    threads = _threads(ctx)
+    views = tile_views(ctx.setup, ctx.surface, ctx.grid, tile, ctx.to_local, threads, prefer=prefer)
     sl = tile.inner_slices
     n_samples = int(views.usable[:, sl[0], sl[1]].sum()) if len(views.cands) else 0
     dtype = np.dtype(ctx.dtype)
-    m = mosaic_tile(views, worker_store(ctx), ctx.correction, ctx.grid.res, ctx.params, fixed)
+    m = mosaic_tile(views, worker_store(ctx), ctx.correction, ctx.grid.res, ctx.params, fixed, threads)
     vals = to_dtype(m.values[:, sl[0], sl[1]], dtype)
     alpha = m.alpha[sl]
     vals[:, ~alpha] = 0
