@@ -82,6 +82,37 @@ def _crs_object(crs):
         raise CRSError(f"cannot use the CRS {str(crs)[:80]!r} for a raster: {exc}") from None
 
 
+_ZSTD: list[bool] = []
+
+
+def _has_zstd() -> bool:
+    """Whether GDAL's GTiff driver writes ZSTD (probed once, in memory)."""
+    if not _ZSTD:
+        import rasterio
+        from rasterio.shutil import delete
+
+        path = f"/vsimem/truortho_zstd_probe_{os.getpid()}_{id(_ZSTD)}.tif"
+        ok = False
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # not georeferenced
+                with rasterio.open(
+                    path, "w", driver="GTiff", width=16, height=16, count=1, dtype="uint8", compress="zstd"
+                ) as ds:
+                    ds.write(np.ones((1, 16, 16), np.uint8))
+                with rasterio.open(path) as ds:
+                    comp = ds.compression
+                    ok = comp is not None and comp.name.lower() == "zstd" and bool(ds.read(1).all())
+        except Exception:
+            ok = False
+        finally:
+            with contextlib.suppress(Exception):
+                delete(path)
+        if not _ZSTD:
+            _ZSTD.append(ok)
+    return _ZSTD[0]
+
+
 class RasterWriter:
     """A GeoTIFF written by windows, renamed into place on success.
 
@@ -170,9 +201,15 @@ class RasterWriter:
             if compress.lower() in ("deflate", "lzw", "zstd"):
                 self.profile["predictor"] = 3 if self.dtype.kind == "f" else 2
             self.profile["num_threads"] = "ALL_CPUS"  # GDAL compresses blocks in threads
-            if cog and compress.lower() == "deflate":
-                # the temporary file is read once by the COG copy, which compresses again: fast level
-                self.profile["zlevel"] = 1
+            if cog:
+                # the temporary file is read once by the COG copy, which compresses again: the
+                # fastest codec this GDAL has (ZSTD level 1, else DEFLATE level 1)
+                if _has_zstd():
+                    self.profile["compress"] = "zstd"
+                    self.profile["zstd_level"] = 1
+                    self.profile["predictor"] = 3 if self.dtype.kind == "f" else 2
+                elif compress.lower() == "deflate":
+                    self.profile["zlevel"] = 1
         if photometric is None and self.dtype == np.uint8 and bands in (3, 4):
             photometric = "RGB"
         if photometric:
@@ -262,7 +299,7 @@ class RasterWriter:
         assert self._tmp is not None
         cog_tmp = self._tmp.with_name(self._tmp.stem + ".cog" + self._tmp.suffix)
         opts = {
-            "compress": self.profile.get("compress", "none").upper(),
+            "compress": (self.compress or "none").upper(),
             "BIGTIFF": "IF_SAFER",
             "blocksize": self.profile["blockxsize"],
             "overview_resampling": self.overview_resampling.upper(),
@@ -473,9 +510,17 @@ class PointCloudWriter:
         decoder of older readers (QGIS 3.22's EPT provider) decompresses.
     """
 
-    def __init__(self, path, crs: str | None = None, rgb: bool = False,
-                 extra: dict[str, Any] | None = None, offsets=None, scale: float = 0.001,
-                 vlrs: Sequence[tuple[str, int, str, bytes]] = (), legacy: bool = False) -> None:
+    def __init__(
+        self,
+        path,
+        crs: str | None = None,
+        rgb: bool = False,
+        extra: dict[str, Any] | None = None,
+        offsets=None,
+        scale: float = 0.001,
+        vlrs: Sequence[tuple[str, int, str, bytes]] = (),
+        legacy: bool = False,
+    ) -> None:
         import laspy
 
         p = Path(os.fspath(path))
@@ -496,8 +541,9 @@ class PointCloudWriter:
 
             header.add_crs(parse_crs(crs))
         for user_id, record_id, description, data in vlrs:
-            header.vlrs.append(laspy.VLR(user_id=user_id, record_id=record_id, description=description,
-                                         record_data=data))
+            header.vlrs.append(
+                laspy.VLR(user_id=user_id, record_id=record_id, description=description, record_data=data)
+            )
         self.header = header
         self._offsets = None if offsets is None else np.asarray(offsets, dtype=np.float64).reshape(3)
         self._tmp: Path | None = None
@@ -516,8 +562,9 @@ class PointCloudWriter:
             self._offsets = np.floor(first_xyz.min(axis=0)) if len(first_xyz) else np.zeros(3)
         self.header.offsets = self._offsets
         try:
-            self._writer = laspy.open(str(self._tmp), mode="w", header=self.header,
-                                      do_compress=self.path.suffix.lower() == ".laz")
+            self._writer = laspy.open(
+                str(self._tmp), mode="w", header=self.header, do_compress=self.path.suffix.lower() == ".laz"
+            )
         except Exception as exc:
             raise FormatError(self.path, f"cannot create the point cloud ({exc})") from None
 
@@ -609,8 +656,9 @@ def write_point_cloud(
     """
     extra = extra or {}
     pts = np.asarray(xyz, dtype=np.float64).reshape(-1, 3)
-    with PointCloudWriter(path, crs, rgb is not None, {k: np.asarray(v).dtype for k, v in extra.items()},
-                          scale=scale) as w:
+    with PointCloudWriter(
+        path, crs, rgb is not None, {k: np.asarray(v).dtype for k, v in extra.items()}, scale=scale
+    ) as w:
         w.write(pts, rgb, **extra)
     return Path(os.fspath(path))
 

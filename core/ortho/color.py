@@ -286,10 +286,13 @@ def estimate_corrections(
     stats["images_constrained"] = int(len(np.unique(np.concatenate([ia, ib])))) if len(ia) else 0
     pair_id = ia * n + ib
     upairs, inverse, counts = np.unique(pair_id, return_inverse=True, return_counts=True)
+    order = np.argsort(inverse, kind="stable")  # the observation pairs grouped by image pair
     rms_before, rms_after, mad_before, mad_after = [], [], [], []
     for ch in range(nch):
         xa, xb = val[ii, ch], val[jj, ch]
-        g, o = _moment_match(upairs, inverse, counts, xa, xb, ia, ib, n, prior, huber, iterations, min_pair)
+        g, o = _moment_match(
+            upairs, inverse, counts, xa, xb, ia, ib, n, prior, huber, iterations, min_pair, order
+        )
         gain[:, ch] = g
         offset[:, ch] = o
         ra = (xa - xb) ** 2
@@ -335,11 +338,12 @@ def _group_percentiles(xs, starts, n, qs, out):
             out[g, j] = np.partition(v, r)[r]
 
 
-def _moment_match(upairs, inverse, counts, xa, xb, ia, ib, n, prior, huber, iterations, min_pair):
+def _moment_match(upairs, inverse, counts, xa, xb, ia, ib, n, prior, huber, iterations, min_pair, order=None):
     """Gains and offsets that equalise the robust moments of every overlapping image pair.
 
     ``xa``, ``xb``: the two values of every observation pair, ``ia``, ``ib`` their images
-    (``ia * n + ib`` is the pair id that ``upairs[inverse]`` groups).
+    (``ia * n + ib`` is the pair id that ``upairs[inverse]`` groups); ``order`` (optional)
+    ``argsort(inverse, kind="stable")``.
 
     For an image pair ``(a, b)`` seen together on ``m`` cells with robust spreads
     ``s`` over those cells, the corrected images have equal spreads when
@@ -355,7 +359,8 @@ def _moment_match(upairs, inverse, counts, xa, xb, ia, ib, n, prior, huber, iter
     connected images towards zero and push the others up to keep the mean.
     """
     k = len(upairs)
-    order = np.argsort(inverse, kind="stable")
+    if order is None:
+        order = np.argsort(inverse, kind="stable")
     _, sa = _robust_moments(xa, inverse, k, order)
     _, sb = _robust_moments(xb, inverse, k, order)
     ok = (counts >= min_pair) & (sa > 1e-9) & (sb > 1e-9)

@@ -97,6 +97,11 @@ def test_cog_rgba(tmp_path):
     with rasterio.open(out) as ds:
         assert ds.count == 4 and ds.overviews(1) and ds.colorinterp[3].name == "alpha"
         assert ds.profile["tiled"]
+        # the fast temporary codec (ZSTD when GDAL has it) never reaches the product: DEFLATE, COG layout
+        assert ds.compression.name.lower() == "deflate"
+        assert ds.tags(ns="IMAGE_STRUCTURE").get("LAYOUT") == "COG"
+        np.testing.assert_array_equal(ds.read(), rgba)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ortho.tif"]  # no temporary left
 
 
 def test_read_onto_grid_reprojects(tmp_path):
