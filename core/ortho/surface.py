@@ -412,7 +412,7 @@ def grid_triangles(
         )
     tris = dsm_triangles(heights, grid.x_min, grid.y_max, grid.res, include, wall_min, tops)
     v = to_local.vertices(tris.vertices) if len(tris.vertices) else tris.vertices
-    return Triangles(v, tris.faces, tris.oriented)
+    return Triangles(v, tris.faces, tris.oriented, tris.groups)
 
 
 # ------------------------------------------------------------------ mesh
@@ -531,7 +531,14 @@ class MeshSurface:
         faces = self.faces[sel]
         used, inv = np.unique(faces, return_inverse=True)
         verts = to_local.vertices(v[used]) if len(used) else np.zeros((0, 3))
-        return Triangles(verts, inv.reshape(-1, 3).astype(np.int32), oriented=False)
+        tris = Triangles(verts, inv.reshape(-1, 3).astype(np.int32), oriented=False)
+        if not len(faces):
+            return tris
+        # faces grouped by blocks of 32 x 32 cells (of their first vertex), so depth buffers skip
+        # the blocks outside their window
+        gc = np.clip(col[faces[:, 0]], 0, grid.cols - 1).astype(np.int64) // 32
+        gr = np.clip(row[faces[:, 0]], 0, grid.rows - 1).astype(np.int64) // 32
+        return tris.grouped(gr * (-(-grid.cols // 32)) + gc)
 
 
 # ------------------------------------------------------------------ opening

@@ -62,11 +62,15 @@ class Triangles:
         Vertex indices, counter-clockwise seen from outside when ``oriented``.
     oriented : bool
         The winding is consistent (back-face culling allowed).
+    groups : (G + 1,) int64, optional
+        Face offsets of groups of nearby faces (default one group); with :attr:`boxes`, their
+        bounding boxes, :func:`render_depth` skips the groups that cannot reach its window.
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     oriented: bool = True
+    groups: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         v = np.ascontiguousarray(np.asarray(self.vertices, dtype=np.float64))
@@ -79,16 +83,56 @@ class Triangles:
             raise InputError("triangles: a face refers to a vertex index out of range")
         self.vertices = v
         self.faces = f
+        g = np.array([0, len(f)], np.int64) if self.groups is None else np.asarray(self.groups, np.int64)
+        if g.ndim != 1 or len(g) < 2 or g[0] != 0 or g[-1] != len(f) or np.any(np.diff(g) < 0):
+            raise InputError("triangles: groups must be ascending face offsets from 0 to the face count")
+        self.groups = np.ascontiguousarray(g)
+        #: (G, 6) bounding box ``x0, y0, z0, x1, y1, z1`` of the vertices of each group's faces
+        self.boxes = np.empty((len(g) - 1, 6))
+        _group_boxes(v, f, self.groups, self.boxes)
 
     def __len__(self) -> int:
         return len(self.faces)
+
+    def grouped(self, key: np.ndarray) -> Triangles:
+        """The same triangles with the faces grouped by ``key`` (M,) int >= 0 (e.g. a plan block), so
+        :func:`render_depth` can skip whole groups outside an image window."""
+        k = np.asarray(key, np.int64)
+        if k.shape != (len(self.faces),) or (len(k) and k.min() < 0):
+            raise InputError("triangles: one non-negative group key per face expected")
+        order = np.argsort(k, kind="stable")
+        counts = np.bincount(k, minlength=1)
+        starts = np.zeros(len(counts) + 1, np.int64)
+        starts[1:] = np.cumsum(counts)
+        return Triangles(self.vertices, self.faces[order], self.oriented, starts)
+
+
+@njit
+def _group_boxes(verts, faces, starts, out):
+    for g in range(len(starts) - 1):
+        for q in range(3):
+            out[g, q] = np.inf
+            out[g, q + 3] = -np.inf
+        for f in range(starts[g], starts[g + 1]):
+            for m in range(3):
+                v = faces[f, m]
+                for q in range(3):
+                    out[g, q] = min(out[g, q], verts[v, q])
+                    out[g, q + 3] = max(out[g, q + 3], verts[v, q])
 
 
 # ---------------------------------------------------------------- DSM -> triangles
 
 
 def dsm_triangles(
-    heights, x_min: float, y_max: float, res: float, include=None, wall_min: float = 0.0, tops=True
+    heights,
+    x_min: float,
+    y_max: float,
+    res: float,
+    include=None,
+    wall_min: float = 0.0,
+    tops=True,
+    block: int = 32,
 ):
     """Triangles of a height grid: flat cell tops plus vertical walls at steps.
 
@@ -116,75 +160,122 @@ def dsm_triangles(
         occluding roof itself next to an occlusion boundary, for the
         near-occluder test of :func:`point_visibility`.
 
+    block : int
+        Faces are grouped by blocks of ``block`` x ``block`` cells (:attr:`Triangles.groups`).
+
     Returns
     -------
     Triangles
         Four vertices (corners NW, NE, SE, SW at the cell's height) for every
         cell a face uses, in row-major cell order.
     """
-    h = np.asarray(heights, dtype=np.float64)
+    h = np.ascontiguousarray(heights, dtype=np.float64)
     if h.ndim != 2:
         raise InputError(f"dsm_triangles: heights must be 2-D, got shape {h.shape}")
     if not res > 0:
         raise InputError(f"dsm_triangles: res must be positive, got {res!r}")
+    if int(block) < 1:
+        raise InputError(f"dsm_triangles: block must be a positive number of cells, got {block!r}")
     rows, cols = h.shape
     valid = np.isfinite(h)
     inc = valid if include is None else (np.asarray(include, dtype=bool) & valid)
-    with np.errstate(invalid="ignore"):
-        step_e = (
-            valid[:, :-1]
-            & valid[:, 1:]
-            & (inc[:, :-1] | inc[:, 1:])
-            & (np.abs(h[:, :-1] - h[:, 1:]) > wall_min)
-        )
-        step_s = (
-            valid[:-1, :]
-            & valid[1:, :]
-            & (inc[:-1, :] | inc[1:, :])
-            & (np.abs(h[:-1, :] - h[1:, :]) > wall_min)
-        )
-    # only the cells some face uses get vertices
     if isinstance(tops, np.ndarray):
         top = inc & np.asarray(tops, dtype=bool)
     else:
         top = inc.copy() if tops else np.zeros_like(inc)
     all_tops = bool(top.sum() == inc.sum())
-    need = top.copy()
-    need[:, :-1] |= step_e
-    need[:, 1:] |= step_e
-    need[:-1, :] |= step_s
-    need[1:, :] |= step_s
-    rr, cc = np.nonzero(need)
-    n = len(rr)
-    base = np.full((rows, cols), -1, np.int64)
-    base[rr, cc] = 4 * np.arange(n, dtype=np.int64)
-    x0 = x_min + cc * res
-    y0 = y_max - rr * res
-    verts = np.empty((n, 4, 3))
-    verts[:, 0, 0], verts[:, 0, 1] = x0, y0
-    verts[:, 1, 0], verts[:, 1, 1] = x0 + res, y0
-    verts[:, 2, 0], verts[:, 2, 1] = x0 + res, y0 - res
-    verts[:, 3, 0], verts[:, 3, 1] = x0, y0 - res
-    verts[:, :, 2] = h[rr, cc][:, None]
+    inc = np.ascontiguousarray(inc)
+    top = np.ascontiguousarray(top)
+    # faces grouped by blocks of cells (the block of a top's cell, of a wall's west or north cell),
+    # so a depth buffer skips the blocks outside its window
+    bs = int(block)
+    gcols = -(-cols // bs)
+    need = np.zeros((rows, cols), np.bool_)
+    per_block = np.zeros(max(1, -(-rows // bs) * gcols), np.int64)
+    _dsm_count(h, inc, top, float(wall_min), bs, need, per_block)
+    starts = np.zeros(len(per_block) + 1, np.int64)
+    starts[1:] = np.cumsum(per_block)
+    n = int(np.count_nonzero(need))
+    verts = np.empty((4 * n, 3))
+    faces = np.empty((int(starts[-1]), 3), np.int32)
+    _dsm_fill(
+        h, inc, top, float(wall_min), bs, need, float(x_min), float(y_max), float(res), starts, verts, faces
+    )
+    return Triangles(verts, faces, oriented=all_tops, groups=starts)
+
+
+@njit
+def _is_step(h, inc, r0, c0, r1, c1, wall_min):
+    a = h[r0, c0]
+    b = h[r1, c1]
+    return np.isfinite(a) and np.isfinite(b) and (inc[r0, c0] or inc[r1, c1]) and abs(a - b) > wall_min
+
+
+@njit
+def _dsm_count(h, inc, top, wall_min, bs, need, per_block):
+    """Cells some face uses (``need``) and faces per block of :func:`dsm_triangles`."""
+    rows, cols = h.shape
+    gcols = (cols + bs - 1) // bs
+    for r in range(rows):
+        for c in range(cols):
+            b = (r // bs) * gcols + c // bs
+            if top[r, c]:
+                need[r, c] = True
+                per_block[b] += 2
+            if c + 1 < cols and _is_step(h, inc, r, c, r, c + 1, wall_min):
+                need[r, c] = True
+                need[r, c + 1] = True
+                per_block[b] += 2
+            if r + 1 < rows and _is_step(h, inc, r, c, r + 1, c, wall_min):
+                need[r, c] = True
+                need[r + 1, c] = True
+                per_block[b] += 2
+
+
+@njit
+def _dsm_fill(h, inc, top, wall_min, bs, need, x_min, y_max, res, starts, verts, faces):
+    """Vertices (corners NW, NE, SE, SW of the needed cells, row-major) and faces by block."""
+    rows, cols = h.shape
+    gcols = (cols + bs - 1) // bs
+    base = np.empty((rows, cols), np.int64)
+    n = 0
+    for r in range(rows):
+        for c in range(cols):
+            if not need[r, c]:
+                continue
+            x0 = x_min + c * res
+            y0 = y_max - r * res
+            z = h[r, c]
+            base[r, c] = 4 * n
+            verts[4 * n, 0], verts[4 * n, 1], verts[4 * n, 2] = x0, y0, z
+            verts[4 * n + 1, 0], verts[4 * n + 1, 1], verts[4 * n + 1, 2] = x0 + res, y0, z
+            verts[4 * n + 2, 0], verts[4 * n + 2, 1], verts[4 * n + 2, 2] = x0 + res, y0 - res, z
+            verts[4 * n + 3, 0], verts[4 * n + 3, 1], verts[4 * n + 3, 2] = x0, y0 - res, z
+            n += 1
+    cur = starts[:-1].copy()
     NW, NE, SE, SW = 0, 1, 2, 3
-    parts = []
-    if top.any():
-        b = base[top]
-        parts.append(np.column_stack([b + NW, b + SW, b + SE]))
-        parts.append(np.column_stack([b + NW, b + SE, b + NE]))
-    # walls between (r, c) = A and (r, c + 1) = B on A's east edge;
-    # the same index triples face +x when A is higher and -x when B is higher
-    a = base[:, :-1][step_e]
-    bb = base[:, 1:][step_e]
-    a_ne, a_se, b_nw, b_sw = a + NE, a + SE, bb + NW, bb + SW
-    parts += [np.column_stack([b_sw, b_nw, a_ne]), np.column_stack([b_sw, a_ne, a_se])]
-    # walls between (r, c) = A and (r + 1, c) = B on A's south edge: -y when A is higher, +y otherwise
-    a = base[:-1, :][step_s]
-    bb = base[1:, :][step_s]
-    a_sw, a_se, b_nw, b_ne = a + SW, a + SE, bb + NW, bb + NE
-    parts += [np.column_stack([b_nw, b_ne, a_se]), np.column_stack([b_nw, a_se, a_sw])]
-    faces = np.concatenate(parts).astype(np.int32)
-    return Triangles(verts.reshape(-1, 3), faces, oriented=all_tops)
+    for r in range(rows):
+        for c in range(cols):
+            b = (r // bs) * gcols + c // bs
+            a = base[r, c]
+            k = cur[b]
+            if top[r, c]:
+                faces[k, 0], faces[k, 1], faces[k, 2] = a + NW, a + SW, a + SE
+                faces[k + 1, 0], faces[k + 1, 1], faces[k + 1, 2] = a + NW, a + SE, a + NE
+                k += 2
+            # wall on the east edge of A = (r, c), B = (r, c + 1): faces +x when A is higher, -x otherwise
+            if c + 1 < cols and _is_step(h, inc, r, c, r, c + 1, wall_min):
+                e = base[r, c + 1]
+                faces[k, 0], faces[k, 1], faces[k, 2] = e + SW, e + NW, a + NE
+                faces[k + 1, 0], faces[k + 1, 1], faces[k + 1, 2] = e + SW, a + NE, a + SE
+                k += 2
+            # wall on the south edge of A = (r, c), B = (r + 1, c): -y when A is higher, +y otherwise
+            if r + 1 < rows and _is_step(h, inc, r, c, r + 1, c, wall_min):
+                e = base[r + 1, c]
+                faces[k, 0], faces[k, 1], faces[k, 2] = e + NW, e + NE, a + SE
+                faces[k + 1, 0], faces[k + 1, 1], faces[k + 1, 2] = e + NW, a + SE, a + SW
+                k += 2
+            cur[b] = k
 
 
 def occluder_wall_min(res: float, max_view_angle_rad: float) -> float:
@@ -304,59 +395,111 @@ def _project_vertices(verts, R, C, p, r2max, uvz):
 
 
 @njit
-def _rasterise(uvz, faces, x0, y0, zbuf, cull):
-    """Min-depth rasterisation of faces into ``zbuf`` (window origin ``(x0, y0)`` in buffer pixels)."""
+def _box_reaches(box, R, C, p, r2max, x0, y0, W, H):
+    """Whether the projection of the box ``x0, y0, z0, x1, y1, z1`` may reach the buffer window:
+    the bounding box of its projected corners, widened by half its size plus 2 pixels (lens
+    distortion bends the box's edges), meets the window; True when a corner does not project."""
+    umin = np.inf
+    umax = -np.inf
+    vmin = np.inf
+    vmax = -np.inf
+    for q in range(8):
+        x = box[3] if q & 1 else box[0]
+        y = box[4] if q & 2 else box[1]
+        z = box[5] if q & 4 else box[2]
+        u, v, d = _proj(x, y, z, R, C, p, r2max)
+        if not d > 0.0:
+            return True
+        umin = min(umin, u)
+        umax = max(umax, u)
+        vmin = min(vmin, v)
+        vmax = max(vmax, v)
+    slack = 0.5 * max(umax - umin, vmax - vmin) + 2.0
+    return (
+        umax + slack >= x0
+        and umin - slack <= x0 + W - 1
+        and vmax + slack >= y0
+        and vmin - slack <= y0 + H - 1
+    )
+
+
+@njit
+def _render(verts, faces, groups, boxes, R, C, p, r2max, x0, y0, zbuf, cull):
+    """Min-depth rasterisation into ``zbuf`` (window origin ``(x0, y0)``) of the faces of the groups
+    whose box may reach the window; vertices are projected once, when a face first needs them."""
     H = zbuf.shape[0]
     W = zbuf.shape[1]
+    uvz = np.empty((verts.shape[0], 3))
+    done = np.zeros(verts.shape[0], np.bool_)
     drawn = 0
-    for f in range(faces.shape[0]):
-        a = faces[f, 0]
-        b = faces[f, 1]
-        c = faces[f, 2]
-        za = uvz[a, 2]
-        zb = uvz[b, 2]
-        zc = uvz[c, 2]
-        if za <= 0.0 or zb <= 0.0 or zc <= 0.0:
+    for g in range(len(groups) - 1):
+        if groups[g + 1] == groups[g]:
             continue
-        ua = uvz[a, 0] - x0
-        va = uvz[a, 1] - y0
-        ub = uvz[b, 0] - x0
-        vb = uvz[b, 1] - y0
-        uc = uvz[c, 0] - x0
-        vc = uvz[c, 1] - y0
-        area = (ub - ua) * (vc - va) - (uc - ua) * (vb - va)
-        if area == 0.0 or (cull and area > 0.0):
+        if not _box_reaches(boxes[g], R, C, p, r2max, x0, y0, W, H):
             continue
-        umin = min(ua, min(ub, uc))
-        umax = max(ua, max(ub, uc))
-        vmin = min(va, min(vb, vc))
-        vmax = max(va, max(vb, vc))
-        i0 = max(np.int64(math.ceil(umin)), 0)
-        i1 = min(np.int64(math.floor(umax)), W - 1)
-        j0 = max(np.int64(math.ceil(vmin)), 0)
-        j1 = min(np.int64(math.floor(vmax)), H - 1)
-        if i0 > i1 or j0 > j1:
-            continue
-        inv = 1.0 / area
-        iza = 1.0 / za
-        izb = 1.0 / zb
-        izc = 1.0 / zc
-        for j in range(j0, j1 + 1):
-            py = float(j)
-            for i in range(i0, i1 + 1):
-                px = float(i)
-                w0 = ((ub - px) * (vc - py) - (uc - px) * (vb - py)) * inv
-                w1 = ((uc - px) * (va - py) - (ua - px) * (vc - py)) * inv
-                w2 = 1.0 - w0 - w1
-                if w0 < -1e-9 or w1 < -1e-9 or w2 < -1e-9:
-                    continue
-                iz = w0 * iza + w1 * izb + w2 * izc
-                if iz <= 0.0:
-                    continue
-                z = 1.0 / iz
-                if z < zbuf[j, i]:
-                    zbuf[j, i] = z
-                    drawn += 1
+        for f in range(groups[g], groups[g + 1]):
+            for m in range(3):
+                i = faces[f, m]
+                if not done[i]:
+                    u, v, z = _proj(verts[i, 0], verts[i, 1], verts[i, 2], R, C, p, r2max)
+                    uvz[i, 0] = u
+                    uvz[i, 1] = v
+                    uvz[i, 2] = z
+                    done[i] = True
+            drawn += _raster_face(uvz, faces[f, 0], faces[f, 1], faces[f, 2], x0, y0, zbuf, cull)
+    return drawn
+
+
+@njit
+def _raster_face(uvz, a, b, c, x0, y0, zbuf, cull):
+    """Min-depth rasterisation of one face (projected vertices ``uvz``); returns the pixels set."""
+    H = zbuf.shape[0]
+    W = zbuf.shape[1]
+    za = uvz[a, 2]
+    zb = uvz[b, 2]
+    zc = uvz[c, 2]
+    if za <= 0.0 or zb <= 0.0 or zc <= 0.0:
+        return 0
+    ua = uvz[a, 0] - x0
+    va = uvz[a, 1] - y0
+    ub = uvz[b, 0] - x0
+    vb = uvz[b, 1] - y0
+    uc = uvz[c, 0] - x0
+    vc = uvz[c, 1] - y0
+    area = (ub - ua) * (vc - va) - (uc - ua) * (vb - va)
+    if area == 0.0 or (cull and area > 0.0):
+        return 0
+    umin = min(ua, min(ub, uc))
+    umax = max(ua, max(ub, uc))
+    vmin = min(va, min(vb, vc))
+    vmax = max(va, max(vb, vc))
+    i0 = max(np.int64(math.ceil(umin)), 0)
+    i1 = min(np.int64(math.floor(umax)), W - 1)
+    j0 = max(np.int64(math.ceil(vmin)), 0)
+    j1 = min(np.int64(math.floor(vmax)), H - 1)
+    if i0 > i1 or j0 > j1:
+        return 0
+    inv = 1.0 / area
+    iza = 1.0 / za
+    izb = 1.0 / zb
+    izc = 1.0 / zc
+    drawn = 0
+    for j in range(j0, j1 + 1):
+        py = float(j)
+        for i in range(i0, i1 + 1):
+            px = float(i)
+            w0 = ((ub - px) * (vc - py) - (uc - px) * (vb - py)) * inv
+            w1 = ((uc - px) * (va - py) - (ua - px) * (vc - py)) * inv
+            w2 = 1.0 - w0 - w1
+            if w0 < -1e-9 or w1 < -1e-9 or w2 < -1e-9:
+                continue
+            iz = w0 * iza + w1 * izb + w2 * izc
+            if iz <= 0.0:
+                continue
+            z = 1.0 / iz
+            if z < zbuf[j, i]:
+                zbuf[j, i] = z
+                drawn += 1
     return drawn
 
 
@@ -450,10 +593,21 @@ def render_depth(
     if w < 1 or h < 1:
         raise InputError(f"render_depth: window must have a positive size, got {window!r}")
     p = scaled_params(camera, scale)
-    uvz = np.empty((len(tris.vertices), 3))
-    _project_vertices(tris.vertices, Rm, Cv, p, valid_radius2(camera), uvz)
     zbuf = np.full((h, w), np.inf, np.float32)
-    _rasterise(uvz, tris.faces, float(x0), float(y0), zbuf, bool(tris.oriented if cull is None else cull))
+    _render(
+        tris.vertices,
+        tris.faces,
+        tris.groups,
+        tris.boxes,
+        Rm,
+        Cv,
+        p,
+        valid_radius2(camera),
+        float(x0),
+        float(y0),
+        zbuf,
+        bool(tris.oriented if cull is None else cull),
+    )
     return zbuf
 
 
