@@ -451,6 +451,22 @@ def _render(verts, faces, groups, boxes, R, C, p, r2max, x0, y0, zbuf, cull):
 
 
 @njit
+def _span(a, b, lo, hi):
+    """``[lo, hi]`` (whole pixels) narrowed to where ``a x + b >= 0`` may hold, a pixel of slack."""
+    if a > 0.0:
+        t = -b / a - 1.0
+        if t > lo:
+            lo = math.ceil(t) if t < hi else hi + 1.0
+    elif a < 0.0:
+        t = -b / a + 1.0
+        if t < hi:
+            hi = math.floor(t) if t > lo else lo - 1.0
+    elif b < -1e-6:
+        hi = lo - 1.0
+    return lo, hi
+
+
+@njit
 def _raster_face(uvz, a, b, c, x0, y0, zbuf, cull):
     """Min-depth rasterisation of one face (projected vertices ``uvz``); returns the pixels set."""
     H = zbuf.shape[0]
@@ -484,9 +500,24 @@ def _raster_face(uvz, a, b, c, x0, y0, zbuf, cull):
     izb = 1.0 / zb
     izc = 1.0 / zc
     drawn = 0
+    # per row, the barycentric weights are linear in x: w_k = a_k x + b_k; only the span where all
+    # three may be >= 0 (widened by a pixel against rounding) is tested pixel by pixel
+    a0 = (vb - vc) * inv
+    a1 = (vc - va) * inv
+    a2 = -(a0 + a1)
     for j in range(j0, j1 + 1):
         py = float(j)
-        for i in range(i0, i1 + 1):
+        b0 = (ub * (vc - py) - uc * (vb - py)) * inv
+        b1 = (uc * (va - py) - ua * (vc - py)) * inv
+        b2 = 1.0 - b0 - b1
+        lo = float(i0)
+        hi = float(i1)
+        lo, hi = _span(a0, b0, lo, hi)
+        lo, hi = _span(a1, b1, lo, hi)
+        lo, hi = _span(a2, b2, lo, hi)
+        if lo > hi:
+            continue
+        for i in range(np.int64(lo), np.int64(hi) + 1):
             px = float(i)
             w0 = ((ub - px) * (vc - py) - (uc - px) * (vb - py)) * inv
             w1 = ((uc - px) * (va - py) - (ua - px) * (vc - py)) * inv
