@@ -83,3 +83,41 @@ def test_weakly_correlated_samples_do_not_shrink_the_gains():
     corr = estimate_corrections(np.array(cells), np.array(imgs), np.array(vals), n_img)
     assert np.abs(corr.gain[:, 0] - g_true).max() < 0.08
     assert corr.gain.min() > 0.7 and corr.gain.max() < 1.3
+
+
+def test_group_percentiles_equal_the_ranks_of_the_sorted_groups():
+    from truortho.core.ortho.color import _group_percentiles
+
+    rng = np.random.default_rng(0)
+    qs = np.array([0.5, 0.1587, 0.8413])
+    for _ in range(100):
+        k = int(rng.integers(1, 8))
+        n = rng.integers(1, 300, k)
+        xs = np.round(rng.normal(size=int(n.sum())), int(rng.integers(0, 3)))  # many ties too
+        starts = np.concatenate([[0], np.cumsum(n)[:-1]])
+        out = np.zeros((k, 3))
+        _group_percentiles(xs.copy(), starts, n, qs, out)
+        for g in range(k):
+            v = np.sort(xs[starts[g] : starts[g] + n[g]])
+            want = [v[min(int(np.floor(q * (n[g] - 1))), n[g] - 1)] for q in qs]
+            np.testing.assert_array_equal(out[g], want)
+
+
+def test_apply_inplace_equals_apply():
+    rng = np.random.default_rng(1)
+    for bands, dt in ((3, "uint8"), (4, "uint16"), (1, "float32"), (3, "float32"), (5, "uint16")):
+        c = ColorCorrection.identity(3, bands)
+        c.gain[1] = rng.uniform(0.8, 1.2, bands)
+        c.offset[1] = rng.uniform(-5, 5, bands)
+        scale = {"uint8": 255.0, "uint16": 65535.0}.get(dt, 1.0)
+        s = (rng.uniform(0, 1, (30, 20, bands)) * scale).astype(np.float32)
+        m = rng.uniform(size=(30, 20)) > 0.3
+        want = s.copy()
+        want[m] = c.apply(1, s[m], dt)
+        got = s.copy()
+        c.apply_inplace(1, got, m, dt)
+        np.testing.assert_allclose(got, want, rtol=0, atol=2e-5 * scale)  # interpolated tables
+        assert np.array_equal(got[~m], s[~m])
+        same = s.copy()
+        c.apply_inplace(0, same, m, dt)  # identity: untouched
+        assert np.array_equal(same, s)
