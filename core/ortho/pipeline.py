@@ -43,7 +43,7 @@ from ..errors import CancelledError, CRSError, InputError, MissingFileError
 from ..grid import RasterGrid
 from ..imagery import image_info
 from ..orientation import Orientation, as_orientation
-from ..parallel import Digest, InProcessExecutor, file_identity, tile_run
+from ..parallel import Digest, InProcessExecutor, file_identity, make_executor, tile_run
 from ..progress import Progress, Steps, SubProgress, as_progress, check
 from .color import ColorCorrection, estimate_corrections, to_channels
 from .mosaic import ImageStore, MosaicParams, candidate_colours
@@ -296,6 +296,9 @@ def true_ortho(
     t_start = time.perf_counter()
     cfg = config or TrueOrthoConfig()
     cfg.validate()
+    if executor is None:
+        # a malformed EXECUTOR / SCHEDULER_ADDRESS fails here, before any work (nothing connects yet)
+        make_executor(cfg.executor, cfg.scheduler_address, n_workers=cfg.dask_workers).close()
     steps = Steps(progress, [1, 3 if cfg.color_correction else 0, 12, 1])
     prog = as_progress(progress)
     o = as_orientation(orientation)

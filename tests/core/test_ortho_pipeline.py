@@ -215,6 +215,17 @@ def test_bad_input_gives_clear_errors_and_no_output(data, tmp_path):
         true_ortho(o2, f / "dsm.tif", out)
     with pytest.raises(MissingFileError):
         true_ortho(f / "orientation.json", tmp_path / "no_dsm.tif", out)
+    # a plain tcp:// scheduler off this machine is refused before any work (no progress reported)
+    said = []
+    with pytest.raises(InputError, match="SCHEDULER_ADDRESS.*unauthenticated"):
+        true_ortho(
+            f / "orientation.json",
+            f / "dsm.tif",
+            out,
+            config=TrueOrthoConfig(executor="scheduler", scheduler_address="tcp://198.51.100.7:8786"),
+            progress=CallbackProgress(lambda fr, m: said.append(m)),
+        )
+    assert not said
     # cancelled half-way: nothing written
     calls = []
     prog = CallbackProgress(lambda fr, m: calls.append(fr), lambda: len(calls) > 3)
