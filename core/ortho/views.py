@@ -432,12 +432,16 @@ def tile_views(
     eff = np.full((Kc, n), np.inf, np.float32)
     counts = np.zeros(Kc, np.int64)
     gsd_all = np.zeros(Kc)
+    # footprint boxes (from frame samples) padded by 5 % and two cells: a cheap first test per cell
+    bxs = setup.boxes[cand_sorted]
+    pad = 0.05 * np.maximum(bxs[:, 2] - bxs[:, 0], bxs[:, 3] - bxs[:, 1]) + 2.0 * res
+    padded = np.column_stack([bxs[:, 0] - pad, bxs[:, 1] - pad, bxs[:, 2] + pad, bxs[:, 3] + pad])
 
     def one(k, cells):
         im = setup.images[k]
         cam = setup.cameras[k]
         r = row_of[int(k)]
-        fc = frame_cells(P, im.R, im.C, cam, setup.max_view, index=cells)
+        fc = frame_cells(P, im.R, im.C, cam, setup.max_view, index=cells, box=padded[row_of[int(k)]])
         if not len(fc):
             return
         # median distance from a regular subsample (the buffer scale and image level need no more)

@@ -718,13 +718,18 @@ def depth_tolerance(res: float, pixel_footprint, tan_view, factor: float = 1.0, 
 
 
 @njit
-def _frame_pass(P, index, R, C, p, r2max, width, height, cos_max, cell_out, u_out, v_out, z_out, dist_out):
+def _frame_pass(
+    P, index, R, C, p, r2max, width, height, cos_max, box, cell_out, u_out, v_out, z_out, dist_out
+):
     """Compacts the points ``P[index[i]]`` in front, inside the frame and within the viewing angle:
     their index into ``P``, full-resolution pixel ``(u, v)``, camera depth and distance go to the
-    first ``m`` entries of the outputs, in the order of ``index``; returns ``m``."""
+    first ``m`` entries of the outputs, in the order of ``index``; returns ``m``. Points outside the
+    plan box ``x0, y0, x1, y1`` (a bound of the footprint) are rejected first."""
     m = 0
     for i in range(index.shape[0]):
         j = index[i]
+        if P[j, 0] < box[0] or P[j, 0] > box[2] or P[j, 1] < box[1] or P[j, 1] > box[3]:
+            continue
         dx = C[0] - P[j, 0]
         dy = C[1] - P[j, 1]
         dz = C[2] - P[j, 2]
@@ -848,10 +853,12 @@ class FrameCells:
         return len(self.cells)
 
 
-def frame_cells(points, R, C, camera: Camera, max_view_rad: float, index=None) -> FrameCells:
+def frame_cells(points, R, C, camera: Camera, max_view_rad: float, index=None, box=None) -> FrameCells:
     """Cells seen inside the frame, in front, within the viewing angle.
 
-    ``points`` (N, 3) local; ``index`` (optional): the rows of ``points`` to test (default all).
+    ``points`` (N, 3) local; ``index`` (optional): the rows of ``points`` to test (default all);
+    ``box`` (optional): ``x0, y0, x1, y1``, a plan box holding every point the image can see
+    (a padded footprint bound), tested first.
     """
     Rm, Cv = _pose(R, C)
     P = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
@@ -869,6 +876,7 @@ def frame_cells(points, R, C, camera: Camera, max_view_rad: float, index=None) -
         float(camera.width),
         float(camera.height),
         math.cos(max_view_rad),
+        np.array([-np.inf, -np.inf, np.inf, np.inf]) if box is None else np.asarray(box, np.float64),
         cells,
         u,
         v,
