@@ -95,23 +95,54 @@ def edge_weights(h: np.ndarray, h0: float):
 
 
 def segments(h: np.ndarray, step: float) -> np.ndarray:
-    """Connected components (4-neighbours) of cells joined by height steps <= ``step``; -1 for no data."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+    """Connected components (4-neighbours) of cells joined by height steps <= ``step``; -1 for no data.
 
+    Components are numbered in the order of their first cell (row-major).
+    """
+    hh = np.ascontiguousarray(h, dtype=np.float64)
+    out = np.empty(hh.shape, np.int64)
+    _segments(hh, float(step), out)
+    return out
+
+
+@njit
+def _root(parent, x):
+    while parent[x] != x:
+        parent[x] = parent[parent[x]]
+        x = parent[x]
+    return x
+
+
+@njit
+def _segments(h, step, out):
     rows, cols = h.shape
-    idx = np.arange(rows * cols).reshape(rows, cols)
-    ok = np.isfinite(h)
-    with np.errstate(invalid="ignore"):
-        eh = ok[:, 1:] & ok[:, :-1] & (np.abs(h[:, 1:] - h[:, :-1]) <= step)
-        ev = ok[1:, :] & ok[:-1, :] & (np.abs(h[1:, :] - h[:-1, :]) <= step)
-    a = np.concatenate([idx[:, :-1][eh], idx[:-1, :][ev]])
-    b = np.concatenate([idx[:, 1:][eh], idx[1:, :][ev]])
-    g = coo_matrix((np.ones(len(a), np.int8), (a, b)), shape=(rows * cols, rows * cols))
-    _, lab = connected_components(g, directed=False)
-    lab = lab.reshape(rows, cols).astype(np.int64)
-    lab[~ok] = -1
-    return lab
+    parent = np.arange(rows * cols)
+    for r in range(rows):
+        for c in range(cols):
+            a = h[r, c]
+            if not np.isfinite(a):
+                continue
+            i = r * cols + c
+            if c + 1 < cols and np.isfinite(h[r, c + 1]) and abs(h[r, c + 1] - a) <= step:
+                x, y = _root(parent, i), _root(parent, i + 1)
+                if x != y:
+                    parent[max(x, y)] = min(x, y)
+            if r + 1 < rows and np.isfinite(h[r + 1, c]) and abs(h[r + 1, c] - a) <= step:
+                x, y = _root(parent, i), _root(parent, i + cols)
+                if x != y:
+                    parent[max(x, y)] = min(x, y)
+    label = np.full(rows * cols, -1, np.int64)
+    n = 0
+    for r in range(rows):
+        for c in range(cols):
+            if not np.isfinite(h[r, c]):
+                out[r, c] = -1
+                continue
+            x = _root(parent, r * cols + c)
+            if label[x] < 0:
+                label[x] = n
+                n += 1
+            out[r, c] = label[x]
 
 
 def initial_labels(

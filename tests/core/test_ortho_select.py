@@ -80,3 +80,34 @@ def test_feather_weights_sum_to_one_and_respect_visibility():
     ramp = w[1][10]
     assert ramp[12] == 0 and 0 < ramp[14] < ramp[15] < ramp[16] < 1 and ramp[18] == 1
     assert np.all(feather_weights(labels, clean, 0)[1] == (labels == 1))
+
+
+def test_segments_are_the_step_connected_components():
+    from collections import deque
+
+    from truortho.core.ortho.select import segments
+
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        rows, cols = (int(v) for v in rng.integers(1, 40, 2))
+        h = np.round(rng.uniform(0, 3, (rows, cols)), 0)
+        h[rng.uniform(size=h.shape) < 0.1] = np.nan
+        got = segments(h, 0.5)
+        # reference: breadth-first search, components numbered by their first cell
+        ref = np.full(h.shape, -1)
+        n = 0
+        for r0 in range(rows):
+            for c0 in range(cols):
+                if np.isnan(h[r0, c0]) or ref[r0, c0] >= 0:
+                    continue
+                ref[r0, c0] = n
+                todo = deque([(r0, c0)])
+                while todo:
+                    r, c = todo.popleft()
+                    for rr, cc in ((r, c + 1), (r, c - 1), (r + 1, c), (r - 1, c)):
+                        if 0 <= rr < rows and 0 <= cc < cols and ref[rr, cc] < 0 and not np.isnan(h[rr, cc]):
+                            if abs(h[rr, cc] - h[r, c]) <= 0.5:
+                                ref[rr, cc] = n
+                                todo.append((rr, cc))
+                n += 1
+        np.testing.assert_array_equal(got, ref)
