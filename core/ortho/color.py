@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import InputError
-from ..jit import njit
+from ..jit import njit, pjit, prange
 
 _M = np.array(
     [[0.4124564, 0.3575761, 0.1804375], [0.2126729, 0.7151522, 0.0721750], [0.0193339, 0.1191920, 0.9503041]]
@@ -347,11 +347,12 @@ def _robust_moments(x: np.ndarray, inverse: np.ndarray, k: int, order: np.ndarra
     return out[:, 0], 0.5 * (out[:, 2] - out[:, 1])
 
 
-@njit
+@pjit
 def _group_percentiles(xs, starts, n, qs, out):
-    """``out[g, j]``: the value of rank ``floor(qs[j] (n_g - 1))`` of group g (values grouped in xs)."""
+    """``out[g, j]``: the value of rank ``floor(qs[j] (n_g - 1))`` of group g (values grouped in xs);
+    groups in parallel."""
     order = np.argsort(qs)
-    for g in range(len(starts)):
+    for g in prange(len(starts)):
         m = n[g]
         if m <= 0:
             continue
