@@ -38,6 +38,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..jit import njit, pjit, prange
+from ..quickselect import select_rank
 
 _M = np.array(
     [[0.4124564, 0.3575761, 0.1804375], [0.2126729, 0.7151522, 0.0721750], [0.0193339, 0.1191920, 0.9503041]]
@@ -361,39 +362,9 @@ def _group_percentiles(xs, starts, n, qs, out):
         for jj in range(len(qs)):  # ascending ranks: each selection leaves the larger values after it
             j = order[jj]
             r = min(int(np.floor(qs[j] * (m - 1))), m - 1)
-            _select(v, lo, m, r)
+            select_rank(v, lo, m - 1, r)
             out[g, j] = v[r]
             lo = r
-
-
-@njit
-def _select(v, lo, hi, k):
-    """Reorder ``v[lo:hi]`` in place so that ``v[k]`` holds the value of rank ``k`` (quickselect),
-    smaller or equal values before it, larger or equal after."""
-    while hi - lo > 1:
-        a = v[lo]
-        b = v[(lo + hi - 1) // 2]
-        c = v[hi - 1]
-        pivot = max(min(a, b), min(max(a, b), c))  # median of three
-        i = lo
-        j = hi - 1
-        while i <= j:
-            while v[i] < pivot:
-                i += 1
-            while v[j] > pivot:
-                j -= 1
-            if i <= j:
-                t = v[i]
-                v[i] = v[j]
-                v[j] = t
-                i += 1
-                j -= 1
-        if k <= j:
-            hi = j + 1
-        elif k >= i:
-            lo = i
-        else:
-            return
 
 
 def _moment_match(upairs, inverse, counts, xa, xb, ia, ib, n, prior, huber, iterations, min_pair, order=None):

@@ -49,6 +49,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..jit import njit, pjit, prange
+from ..quickselect import select_rank
 
 #: Largest cost. Chosen so that the sum over 16 paths of path costs, each at
 #: most ``COST_MAX + P2`` (see :mod:`.aggregation`), fits ``uint16`` for every
@@ -271,39 +272,7 @@ def _smallest_sum(buf, m, k):
     Linear on average, where the insertion sort it replaces was quadratic in the
     number of pairs (66 for 12 views).
     """
-    lo = 0
-    hi = m - 1
-    while lo < hi:
-        mid = (lo + hi) // 2
-        # median of three as the pivot
-        a, b, c = buf[lo], buf[mid], buf[hi]
-        if a > b:
-            a, b = b, a
-        if b > c:
-            b = c
-            if a > b:
-                b = a
-        pivot = b
-        i = lo
-        j = hi
-        while i <= j:
-            while buf[i] < pivot:
-                i += 1
-            while buf[j] > pivot:
-                j -= 1
-            if i <= j:
-                t = buf[i]
-                buf[i] = buf[j]
-                buf[j] = t
-                i += 1
-                j -= 1
-        # buf[lo..j] <= pivot <= buf[i..hi]
-        if k - 1 <= j:
-            hi = j
-        elif k - 1 >= i:
-            lo = i
-        else:
-            break
+    select_rank(buf, 0, m - 1, k - 1)
     s = 0.0
     for q in range(k):
         s += buf[q]
