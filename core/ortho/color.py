@@ -306,10 +306,9 @@ def estimate_corrections(
     ii, jj = np.where(swap, jj, ii), np.where(swap, ii, jj)
     ia, ib = img[ii], img[jj]
     stats["pairs"] = int(len(ii))
-    stats["images_constrained"] = int(len(np.unique(np.concatenate([ia, ib])))) if len(ia) else 0
+    stats["images_constrained"] = int(np.count_nonzero(np.bincount(np.concatenate([ia, ib]), minlength=n)))
     pair_id = ia * n + ib
-    upairs, inverse, counts = np.unique(pair_id, return_inverse=True, return_counts=True)
-    order = np.argsort(inverse, kind="stable")  # the observation pairs grouped by image pair
+    upairs, inverse, counts, order = _group_ids(pair_id, n * n)
     rms_before, rms_after, mad_before, mad_after = [], [], [], []
     for ch in range(nch):
         xa, xb = val[ii, ch], val[jj, ch]
@@ -330,6 +329,35 @@ def estimate_corrections(
     stats["median_before"] = [round(v, 4) for v in mad_before]
     stats["median_after"] = [round(v, 4) for v in mad_after]
     return ColorCorrection(gain, offset, uses_lab(nch), stats)
+
+
+def _group_ids(ids: np.ndarray, id_range: int):
+    """``np.unique(ids, return_inverse=True, return_counts=True)`` plus the stable order that groups
+    the ids (``argsort(inverse, kind="stable")``), by counting when ``id_range`` is moderate."""
+    if id_range > 16 * max(len(ids), 1 << 16):
+        uniq, inverse, counts = np.unique(ids, return_inverse=True, return_counts=True)
+        return uniq, inverse, counts, np.argsort(inverse, kind="stable")
+    full = np.bincount(ids, minlength=id_range)
+    uniq = np.flatnonzero(full)
+    rank = np.zeros(id_range, np.int64)
+    rank[uniq] = np.arange(len(uniq))
+    inverse = rank[ids]
+    counts = full[uniq]
+    order = np.empty(len(ids), np.int64)
+    _counting_order(inverse, counts, order)
+    return uniq, inverse, counts, order
+
+
+@njit
+def _counting_order(inverse, counts, order):
+    """Stable order of ``inverse`` (group of each item) by counting sort."""
+    start = np.zeros(len(counts), np.int64)
+    for g in range(1, len(counts)):
+        start[g] = start[g - 1] + counts[g - 1]
+    for i in range(len(inverse)):
+        g = inverse[i]
+        order[start[g]] = i
+        start[g] += 1
 
 
 def _robust_moments(x: np.ndarray, inverse: np.ndarray, k: int, order: np.ndarray | None = None):

@@ -121,3 +121,18 @@ def test_apply_inplace_equals_apply():
         same = s.copy()
         c.apply_inplace(0, same, m, dt)  # identity: untouched
         assert np.array_equal(same, s)
+
+
+def test_group_ids_equal_unique_and_stable_argsort():
+    from truortho.core.ortho.color import _group_ids
+
+    rng = np.random.default_rng(0)
+    for n in (1, 5, 40, 3000):
+        ids = rng.integers(0, n * n, int(rng.integers(0, 5000)))
+        for id_range in (n * n, 10**12):  # by counting, and by sorting
+            uniq, inverse, counts, order = _group_ids(ids, id_range)
+            u2, inv2, c2 = np.unique(ids, return_inverse=True, return_counts=True)
+            np.testing.assert_array_equal(uniq, u2)
+            np.testing.assert_array_equal(inverse, inv2)
+            np.testing.assert_array_equal(counts, c2)
+            np.testing.assert_array_equal(order, np.argsort(inv2, kind="stable"))
