@@ -4,7 +4,8 @@
 cache bounded in bytes, and serves reduced levels (area-averaged halvings) so
 an output cell coarser than the image pixel samples a pixel of about its own
 size instead of aliasing. :func:`candidate_colours` reads the colours of a tile's cells
-from every candidate image (bilinear, one compiled pass per image), any band count and dtype.
+from every candidate image (bilinear, one compiled pass per image), any band count and dtype;
+:func:`candidate_luminance` only their luminance (for the seam costs).
 
 :func:`mosaic_tile` turns the visibility of a tile (:mod:`.views`) into output
 values: data costs and labels (:mod:`.select`), colours of every candidate
@@ -168,28 +169,6 @@ class ImageStore:
         return max(0, min(8, int(math.floor(math.log2(res / gsd) + 1e-9))))
 
 
-def luminance01(col: np.ndarray, dtype) -> np.ndarray:
-    """Luminance in [0, 1]-ish units of samples (..., bands) float32 (Rec. 601 for RGB, band 1 otherwise).
-
-    NaN where the sample is NaN.
-    """
-    s = float(value_scale(dtype))
-    c = np.ascontiguousarray(col, dtype=np.float32)
-    out = np.empty(c.shape[:-1], np.float32)
-    _luminance(c.reshape(-1, c.shape[-1]), 1.0 / s, out.reshape(-1))
-    return out
-
-
-@njit
-def _luminance(c, inv_scale, out):
-    rgb = c.shape[1] >= 3
-    for i in range(c.shape[0]):
-        if rgb:
-            out[i] = (0.299 * c[i, 0] + 0.587 * c[i, 1] + 0.114 * c[i, 2]) * inv_scale
-        else:
-            out[i] = c[i, 0] * inv_scale
-
-
 @dataclass
 class MosaicParams:
     """Selection and blending parameters (see :class:`~.pipeline.TrueOrthoConfig`)."""
@@ -224,20 +203,46 @@ def candidate_colours(
     res: float,
     needed: np.ndarray | None = None,
     workers: int = 1,
+    fill: bool = True,
 ) -> np.ndarray:
     """Colours ``(K, rows, cols, bands)`` float32 of every candidate where usable (bilinear, border
     replicated), corrected when ``correction`` is given.
 
-    NaN where the candidate is not usable (or not ``needed``). Images run in ``workers`` threads.
+    NaN where the candidate is not usable (or not ``needed``); with ``fill=False`` those entries
+    are left unset (for a caller that reads only the needed ones). Images run in ``workers`` threads.
     """
     K, rows, cols = views.usable.shape
     out = np.empty((K, rows, cols, store.bands), np.float32)
+    _sample_candidates(views, store, res, needed, workers, out, None, fill, correction)
+    return out
+
+
+def candidate_luminance(views: TileViews, store: ImageStore, res: float, workers: int = 1) -> np.ndarray:
+    """Luminance in [0, 1]-ish units ``(K, rows, cols)`` float32 of every candidate where usable
+    (Rec. 601 of the first three bands of RGB data, band 1 otherwise; bilinear, uncorrected), NaN
+    elsewhere: the luminance of :func:`candidate_colours` without computing the colours."""
+    K, rows, cols = views.usable.shape
+    lw = np.zeros(store.bands)
+    if store.bands >= 3:
+        lw[:3] = (0.299, 0.587, 0.114)
+    else:
+        lw[0] = 1.0
+    lw /= float(value_scale(store.dtype))
+    out = np.empty((K, rows, cols, 1), np.float32)
+    _sample_candidates(views, store, res, None, workers, out, lw, True, None)
+    return out[..., 0]
+
+
+def _sample_candidates(views, store, res, needed, workers, out, lum_weights, fill, correction) -> None:
+    K = views.usable.shape[0]
+    lw = np.zeros(1) if lum_weights is None else np.ascontiguousarray(lum_weights, np.float64)
 
     def one(k):
         m = views.usable[k] if needed is None else (views.usable[k] & needed[k])
         i = int(views.cands[k])
         if not m.any():
-            out[k] = np.nan
+            if fill:
+                out[k] = np.nan
             return
         level = store.level_for(float(views.gsd[k]), res)
         uvk = views.uv[k]
@@ -251,13 +256,15 @@ def candidate_colours(
             lsize[1] / H,
             float(origin[0]),
             float(origin[1]),
+            lw,
+            lum_weights is not None,
+            fill,
             out[k],
         )
         if correction is not None:
             correction.apply_inplace(i, out[k], m, store.dtype)
 
     each(one, range(K), workers)
-    return out
 
 
 def each(fn, items, workers: int = 1) -> None:
@@ -274,19 +281,25 @@ def each(fn, items, workers: int = 1) -> None:
 
 
 @njit
-def _bilinear_into(img, uv, mask, sx, sy, ox, oy, out):
+def _bilinear_into(img, uv, mask, sx, sy, ox, oy, lum_w, lum, fill, out):
     """``out[r, c]`` = bilinear sample (border replicated) of ``img`` (h, w, bands) at the
     full-resolution pixel ``uv[r, c]`` mapped to the level (``x' = (x + 0.5) sx - 0.5``) and
-    shifted by the window origin ``(ox, oy)``; NaN where ``mask`` is False or uv is NaN."""
+    shifted by the window origin ``(ox, oy)`` — with ``lum`` the single value ``sum_b lum_w[b]
+    sample_b`` in ``out[r, c, 0]``; NaN where ``mask`` is False or uv is NaN (left unset there
+    without ``fill``)."""
     H, W, B = img.shape
     rows, cols = mask.shape
+    nout = out.shape[2]
     for r in range(rows):
         for c in range(cols):
-            x = (np.float64(uv[r, c, 0]) + 0.5) * sx - 0.5 - ox
-            y = (np.float64(uv[r, c, 1]) + 0.5) * sy - 0.5 - oy
-            if not mask[r, c] or not (x == x and y == y):
-                for b in range(B):
-                    out[r, c, b] = np.nan
+            x = y = np.nan
+            if mask[r, c]:
+                x = (np.float64(uv[r, c, 0]) + 0.5) * sx - 0.5 - ox
+                y = (np.float64(uv[r, c, 1]) + 0.5) * sy - 0.5 - oy
+            if not (x == x and y == y):
+                if fill:
+                    for b in range(nout):
+                        out[r, c, b] = np.nan
                 continue
             xf = math.floor(x)
             yf = math.floor(y)
@@ -296,10 +309,30 @@ def _bilinear_into(img, uv, mask, sx, sy, ox, oy, out):
             i1 = min(max(np.int64(xf) + 1, 0), W - 1)
             j0 = min(max(np.int64(yf), 0), H - 1)
             j1 = min(max(np.int64(yf) + 1, 0), H - 1)
-            for b in range(B):
-                top = np.float64(img[j0, i0, b]) * (1.0 - fx) + np.float64(img[j0, i1, b]) * fx
-                bot = np.float64(img[j1, i0, b]) * (1.0 - fx) + np.float64(img[j1, i1, b]) * fx
-                out[r, c, b] = top * (1.0 - fy) + bot * fy
+            w00 = (1.0 - fx) * (1.0 - fy)
+            w01 = fx * (1.0 - fy)
+            w10 = (1.0 - fx) * fy
+            w11 = fx * fy
+            if lum:
+                acc = 0.0
+                for b in range(B):
+                    if lum_w[b] != 0.0:
+                        v = (
+                            np.float64(img[j0, i0, b]) * w00
+                            + np.float64(img[j0, i1, b]) * w01
+                            + np.float64(img[j1, i0, b]) * w10
+                            + np.float64(img[j1, i1, b]) * w11
+                        )
+                        acc += lum_w[b] * v
+                out[r, c, 0] = acc
+            else:
+                for b in range(B):
+                    out[r, c, b] = (
+                        np.float64(img[j0, i0, b]) * w00
+                        + np.float64(img[j0, i1, b]) * w01
+                        + np.float64(img[j1, i0, b]) * w10
+                        + np.float64(img[j1, i1, b]) * w11
+                    )
 
 
 @njit
@@ -351,11 +384,9 @@ def mosaic_tile(
     seen = usable.any(axis=0)
     occl[valid & seen] = 0
     cost = data_costs(views.eff_res, usable, views.near_edge, params.edge_penalty)
-    # raw colours of every candidate; the seam cost uses their luminance corrected by the
-    # lightness (or first band) gain and offset, the full correction is applied below only to
-    # the samples that enter the mosaic
-    colours = candidate_colours(views, store, None, res, workers=workers)
-    lum = luminance01(colours, store.dtype)
+    # the seam cost uses every candidate's luminance corrected by the lightness (or first band)
+    # gain and offset; colours (fully corrected) are sampled below only where they enter the mosaic
+    lum = candidate_luminance(views, store, res, workers)
     if correction is not None:
         for k, i in enumerate(views.cands):
             if not correction.is_identity(int(i)):
@@ -380,12 +411,8 @@ def mosaic_tile(
     )
     clean = usable & ~views.near_edge
     w = feather_weights(labels, clean, params.blend_width)
-    if correction is not None:
-        each(
-            lambda k: correction.apply_inplace(int(views.cands[k]), colours[k], w[k] > 0, store.dtype),
-            range(K),
-            workers,
-        )
+    # _blend reads a candidate's colour only where its weight is positive: only those are sampled
+    colours = candidate_colours(views, store, correction, res, w > 0, workers, fill=False)
     values = np.empty((bands, rows, cols), np.float32)
     _blend(w, colours, values)
     alpha = labels >= 0
