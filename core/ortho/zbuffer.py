@@ -25,7 +25,10 @@ the camera, outside the window or beyond the valid field of the distortion
 model are skipped) and optional back-face culling; depth is interpolated
 perspective-correctly (``1/z`` is linear in the image). The buffer may be
 coarser than the image (``scale`` < 1, pixel centres mapping as in
-:meth:`~truortho.core.geometry.camera.Camera.scaled`).
+:meth:`~truortho.core.geometry.camera.Camera.scaled`). Faces come in groups
+(:attr:`Triangles.groups`: a DSM's by blocks of cells) with bounding boxes; a
+group whose projected box, widened by half its size for lens distortion, misses
+the window is skipped whole, and a vertex is projected only when a face needs it.
 
 :func:`point_visibility` projects cell surface points into the buffer: a point
 is *visible* when its depth ``z`` satisfies ``z <= zbuf + tol`` at the buffer
@@ -708,7 +711,7 @@ def depth_tolerance(res: float, pixel_footprint, tan_view, factor: float = 1.0, 
     DSM of cell size ``res`` deviate from a surface of gradient ``slope`` by up
     to one stair step ``res * slope`` (the slope from the smaller one-sided
     height differences, so a cell next to a wall keeps the slope of its own
-    roof or ground). The fused pass of :func:`view_cells` uses the same formula.
+    roof or ground). The fused pass of :func:`view_cells_into` uses the same formula.
     """
     base = np.maximum(float(res), pixel_footprint) * (1.0 + np.asarray(tan_view))
     return factor * (base + float(res) * np.asarray(slope))
