@@ -441,7 +441,7 @@ def tile_views(
         im = setup.images[k]
         cam = setup.cameras[k]
         r = row_of[int(k)]
-        fc = frame_cells(P, im.R, im.C, cam, setup.max_view, index=cells, box=padded[row_of[int(k)]])
+        fc = frame_cells(P, im.R, im.C, cam, setup.max_view, index=cells, box=padded[r])
         if not len(fc):
             return
         # median distance from a regular subsample (the buffer scale and image level need no more)
