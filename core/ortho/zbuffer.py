@@ -194,16 +194,15 @@ def dsm_triangles(
     bs = int(block)
     gcols = -(-cols // bs)
     need = np.zeros((rows, cols), np.bool_)
+    steps = np.zeros((rows, cols), np.uint8)
     per_block = np.zeros(max(1, -(-rows // bs) * gcols), np.int64)
-    _dsm_count(h, inc, top, float(wall_min), bs, need, per_block)
+    _dsm_count(h, inc, top, float(wall_min), bs, need, steps, per_block)
     starts = np.zeros(len(per_block) + 1, np.int64)
     starts[1:] = np.cumsum(per_block)
     n = int(np.count_nonzero(need))
     verts = np.empty((4 * n, 3))
     faces = np.empty((int(starts[-1]), 3), np.int32)
-    _dsm_fill(
-        h, inc, top, float(wall_min), bs, need, float(x_min), float(y_max), float(res), starts, verts, faces
-    )
+    _dsm_fill(h, top, bs, need, steps, float(x_min), float(y_max), float(res), starts, verts, faces)
     return Triangles(verts, faces, oriented=all_tops, groups=starts)
 
 
@@ -211,12 +210,13 @@ def dsm_triangles(
 def _is_step(h, inc, r0, c0, r1, c1, wall_min):
     a = h[r0, c0]
     b = h[r1, c1]
-    return np.isfinite(a) and np.isfinite(b) and (inc[r0, c0] or inc[r1, c1]) and abs(a - b) > wall_min
+    return (inc[r0, c0] or inc[r1, c1]) and np.isfinite(a) and np.isfinite(b) and abs(a - b) > wall_min
 
 
 @njit
-def _dsm_count(h, inc, top, wall_min, bs, need, per_block):
-    """Cells some face uses (``need``) and faces per block of :func:`dsm_triangles`."""
+def _dsm_count(h, inc, top, wall_min, bs, need, steps, per_block):
+    """Cells some face uses (``need``), walls on the east (bit 1) and south (bit 2) edge of each cell
+    (``steps``) and faces per block of :func:`dsm_triangles`."""
     rows, cols = h.shape
     gcols = (cols + bs - 1) // bs
     for r in range(rows):
@@ -228,15 +228,17 @@ def _dsm_count(h, inc, top, wall_min, bs, need, per_block):
             if c + 1 < cols and _is_step(h, inc, r, c, r, c + 1, wall_min):
                 need[r, c] = True
                 need[r, c + 1] = True
+                steps[r, c] |= 1
                 per_block[b] += 2
             if r + 1 < rows and _is_step(h, inc, r, c, r + 1, c, wall_min):
                 need[r, c] = True
                 need[r + 1, c] = True
+                steps[r, c] |= 2
                 per_block[b] += 2
 
 
 @njit
-def _dsm_fill(h, inc, top, wall_min, bs, need, x_min, y_max, res, starts, verts, faces):
+def _dsm_fill(h, top, bs, need, steps, x_min, y_max, res, starts, verts, faces):
     """Vertices (corners NW, NE, SE, SW of the needed cells, row-major) and faces by block."""
     rows, cols = h.shape
     gcols = (cols + bs - 1) // bs
@@ -267,13 +269,13 @@ def _dsm_fill(h, inc, top, wall_min, bs, need, x_min, y_max, res, starts, verts,
                 faces[k + 1, 0], faces[k + 1, 1], faces[k + 1, 2] = a + NW, a + SE, a + NE
                 k += 2
             # wall on the east edge of A = (r, c), B = (r, c + 1): faces +x when A is higher, -x otherwise
-            if c + 1 < cols and _is_step(h, inc, r, c, r, c + 1, wall_min):
+            if steps[r, c] & 1:
                 e = base[r, c + 1]
                 faces[k, 0], faces[k, 1], faces[k, 2] = e + SW, e + NW, a + NE
                 faces[k + 1, 0], faces[k + 1, 1], faces[k + 1, 2] = e + SW, a + NE, a + SE
                 k += 2
             # wall on the south edge of A = (r, c), B = (r + 1, c): -y when A is higher, +y otherwise
-            if r + 1 < rows and _is_step(h, inc, r, c, r + 1, c, wall_min):
+            if steps[r, c] & 2:
                 e = base[r + 1, c]
                 faces[k, 0], faces[k, 1], faces[k, 2] = e + NW, e + NE, a + SE
                 faces[k + 1, 0], faces[k + 1, 1], faces[k + 1, 2] = e + NW, a + SE, a + SW
