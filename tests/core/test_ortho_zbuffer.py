@@ -197,3 +197,40 @@ def test_grouped_faces_skip_nothing_the_window_needs(scene, k1):
     np.testing.assert_array_equal(
         render_depth(one.grouped(key), im.R, im.C, cam, win), render_depth(one, im.R, im.C, cam, win)
     )
+
+
+def test_concurrent_resampled_dsm_reads_equal_serial_reads(tmp_path):
+    """Tile threads resample the DSM concurrently (output cells differ from the DSM's); rasterio then
+    now and then warns 'no geotransform', but every read must give the serial result."""
+    import threading
+    import warnings
+
+    from truortho.core.ortho.surface import DsmSurface
+    from truortho.core.rasterio_io import write_raster
+
+    src = RasterGrid(500000.0, 5600030.0, 1.0 / 3.0, 90, 120, "EPSG:32632")
+    X, Y = src.centres()
+    h = (10.0 + 0.05 * (X - 500000.0) + 3.0 * ((X - 500020.0) ** 2 + (Y - 5600015.0) ** 2 < 25.0)).astype(
+        np.float32
+    )
+    write_raster(tmp_path / "dsm.tif", h, src, nodata=-9999.0)
+    surf = DsmSurface(tmp_path / "dsm.tif")
+    out = RasterGrid(500000.0, 5600030.0, 0.25, 120, 160, "EPSG:32632")
+    windows = [out.window(-20 + 13 * i, -20 + 17 * i, 80 + i, 90 + i) for i in range(6)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ref = [surf.heights_on(w) for w in windows]
+        bad = []
+
+        def run(i):
+            for _ in range(10):
+                if not np.array_equal(surf.heights_on(windows[i]), ref[i], equal_nan=True):
+                    bad.append(i)
+
+        threads = [threading.Thread(target=run, args=(i,)) for i in range(len(windows))]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
+    assert all(np.isfinite(r).any() for r in ref)
+    assert not bad
