@@ -15,6 +15,8 @@ def select_rank(buf, lo, hi, k):
     """Reorder ``buf[lo..hi]`` (inclusive, ``lo <= k <= hi``) in place so that ``buf[k]`` holds the
     value of rank ``k - lo`` among them, values <= it before and >= it after (median-of-three
     pivots, Hoare partition)."""
+    if lo < 0 or hi >= len(buf) or not lo <= k <= hi:
+        raise ValueError("select_rank: expected 0 <= lo <= k <= hi < len(buf)")
     while lo < hi:
         mid = (lo + hi) // 2
         # median of three as the pivot

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FormatError, InputError
-from ..imagery import read_image_sized, read_level_window
+from ..imagery import REC601, read_image_sized, read_level_window
 from ..jit import njit
 from .color import ColorCorrection, value_scale
 from .seams import feather_weights
@@ -224,7 +224,7 @@ def candidate_luminance(views: TileViews, store: ImageStore, res: float, workers
     K, rows, cols = views.usable.shape
     lw = np.zeros(store.bands)
     if store.bands >= 3:
-        lw[:3] = (0.299, 0.587, 0.114)
+        lw[:3] = REC601
     else:
         lw[0] = 1.0
     lw /= float(value_scale(store.dtype))

@@ -868,6 +868,10 @@ def frame_cells(points, R, C, camera: Camera, max_view_rad: float, index=None, b
     Rm, Cv = _pose(R, C)
     P = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
     ix = np.arange(len(P)) if index is None else np.ascontiguousarray(np.asarray(index, dtype=np.int64))
+    if len(ix) and (ix.min() < 0 or ix.max() >= len(P)):
+        raise InputError("frame_cells: index out of range of the points")
+    if box is not None and np.shape(box) != (4,):
+        raise InputError(f"frame_cells: box must be (x0, y0, x1, y1), got shape {np.shape(box)}")
     n = len(ix)
     cells = np.empty(n, np.int64)
     u, v, z, d = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
@@ -934,6 +938,16 @@ def view_cells_into(
     if not (P.shape == Sm.shape == N.shape and P.ndim == 2 and P.shape[1] == 3 and moved.shape == (len(P),)):
         raise InputError("view_cells_into: points, samples and normals must be (N, 3) arrays of one shape")
     usable, edge, uv, eff = out
+    n = len(P)
+    if not (
+        usable.shape == edge.shape == eff.shape == (n,)
+        and uv.shape == (n, 2)
+        and usable.dtype == edge.dtype == moved.dtype == np.bool_
+        and uv.dtype == eff.dtype == np.float32
+    ):
+        raise InputError("view_cells_into: out must be (N,) bool, (N,) bool, (N, 2) and (N,) float32")
+    if len(fc) and fc.cells.max() >= n:
+        raise InputError("view_cells_into: the frame cells refer to points beyond the arrays")
     if zbuf is None:
         zbuf = np.full((1, 1), np.inf, np.float32)
         window = (0, 0, 1, 1)
