@@ -53,6 +53,7 @@ from .tiles import (
     DoneLabels,
     OrthoContext,
     OrthoTask,
+    ViewPrefetch,
     ortho_tile_task,
     side_of,
     task_memory,
@@ -421,20 +422,34 @@ def true_ortho(
         "margin_cells": setup.margin_cells,
         "reprojected": not to_local.identity,
     }
-    # ---- colour correction
-    correction = None
-    t0 = time.perf_counter()
-    if cfg.color_correction and len(relevant) > 1:
-        correction = _estimate_colour(
-            setup, surf, grid, to_local, store, cfg, steps[1], workers, len(o.images)
-        )
-        stats["color_correction"] = correction.as_dict([im.name for im in o.images])
-    stats["seconds_color"] = round(time.perf_counter() - t0, 3)
-    # ---- mosaic
-    t0 = time.perf_counter()
+    # ---- tiles, in waves (the costliest of a wave first; results do not depend on the order)
     overlap = max(cfg.blend_width, 4) + 8
     tiles = grid.tiles(cfg.tile_size, overlap)
     sub = steps[2]
+    ctx = OrthoContext(
+        setup,
+        surf,
+        grid,
+        to_local,
+        tuple(paths),
+        tuple((int(sw), int(sh)) for sw, sh in sizes),
+        bands,
+        dtype.name,
+        cfg.image_cache_mb << 20,
+        None,  # the colour correction, set below
+        params,
+        workers,
+        store=store,
+    )
+    k_tile = tile_candidates(setup, grid, tiles, to_local)
+    k_max = int(max(1, k_tile.max()))
+    cost = dict(zip((t.index for t in tiles), tile_costs(setup, grid, tiles, k_tile), strict=True))
+    # a wave runs in batches of at most ~256 MiB of results, so the client's memory is bounded
+    per_tile = (cfg.tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
+    batch_tiles = max(1, (256 << 20) // per_tile)
+    ordered = [sorted(w, key=lambda t: (-cost[t.index], t.index)) for w in waves(tiles)]
+    batches = [w[i : i + batch_tiles] for w in ordered for i in range(0, len(w), batch_tiles)]
+    in_process = isinstance(executor, InProcessExecutor) or (executor is None and cfg.executor == "inprocess")
     parts: dict[int, list] = {}
     counts = np.zeros(len(o.images), np.int64)
     n_seen = n_valid = n_occl = n_samples = 0
@@ -443,6 +458,24 @@ def true_ortho(
     with contextlib.ExitStack() as stack:
         from ..rasterio_io import RasterWriter
 
+        if in_process and ViewPrefetch.usable(setup):
+            # the visibility of the coming tiles runs ahead in a background thread: the first
+            # wave's during the colour statistics, the next wave's during this one's mosaic
+            ctx.prefetch = ViewPrefetch(ctx, limit=workers)
+            stack.callback(ctx.prefetch.close)
+            ctx.prefetch.submit(batches[0])
+        # ---- colour correction
+        correction = None
+        t0 = time.perf_counter()
+        if cfg.color_correction and len(relevant) > 1:
+            correction = _estimate_colour(
+                setup, surf, grid, to_local, store, cfg, steps[1], workers, len(o.images)
+            )
+            stats["color_correction"] = correction.as_dict([im.name for im in o.images])
+        ctx.correction = correction
+        stats["seconds_color"] = round(time.perf_counter() - t0, 3)
+        # ---- mosaic
+        t0 = time.perf_counter()
         # scratch tiles beside the output: a rerun after a crash resumes from them
         executor, cache = stack.enter_context(
             tile_run(
@@ -506,24 +539,6 @@ def true_ortho(
             )
         tri_max = 0
         done = DoneLabels(overlap)  # border strips of the labels of finished tiles
-        ctx = OrthoContext(
-            setup,
-            surf,
-            grid,
-            to_local,
-            tuple(paths),
-            tuple((int(sw), int(sh)) for sw, sh in sizes),
-            bands,
-            dtype.name,
-            cfg.image_cache_mb << 20,
-            correction,
-            params,
-            workers,
-            store=store,
-        )
-        k_tile = tile_candidates(setup, grid, tiles, to_local)
-        k_max = int(max(1, k_tile.max()))
-        cost = dict(zip((t.index for t in tiles), tile_costs(setup, grid, tiles, k_tile), strict=True))
         img_bytes = max(w * h for w, h in (sizes[i] for i in relevant)) * bands * dtype.itemsize * 4 // 3
         memory = task_memory(
             side_of(cfg.tile_size, overlap),
@@ -536,14 +551,10 @@ def true_ortho(
         stats["task_memory_mb"] = round(memory / 2**20, 1)
         base = _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs)
         n_done = 0
-        # a wave runs in batches of at most ~256 MiB of results, so the client's memory is bounded
-        per_tile = (cfg.tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
-        batch_tiles = max(1, (256 << 20) // per_tile)
-        # the costliest tiles of a wave first (results do not depend on the order)
-        ordered = [sorted(w, key=lambda t: (-cost[t.index], t.index)) for w in waves(tiles)]
-        batches = [w[i : i + batch_tiles] for w in ordered for i in range(0, len(w), batch_tiles)]
-        for wave in batches:
+        for bi, wave in enumerate(batches):
             check(progress)
+            if ctx.prefetch is not None and bi + 1 < len(batches):
+                ctx.prefetch.submit(batches[bi + 1])
             tasks = [OrthoTask(t, done.fixed(t)) for t in wave]
             wsub = SubProgress(sub, n_done / len(tiles), (n_done + len(wave)) / len(tiles))
             try:
@@ -559,6 +570,8 @@ def true_ortho(
                 )
             except CancelledError:
                 raise CancelledError("true orthophoto cancelled") from None
+            if ctx.prefetch is not None:
+                ctx.prefetch.discard(wave)  # tiles found in the tile cache were not taken
             for tile, (out_t, lab, occ, counters) in zip(wave, results, strict=True):
                 n_samples += int(counters[0])
                 tri_max = max(tri_max, int(counters[1]))

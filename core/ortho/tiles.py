@@ -49,7 +49,7 @@ from ..parallel import Digest, ProcessLRU, task_cancelled, tune_worker_malloc
 from .color import ColorCorrection
 from .mosaic import ImageStore, MosaicParams, mosaic_tile, to_dtype
 from .surface import PlanTransform
-from .views import ViewSetup, tile_views
+from .views import ViewSetup, all_tile_views, prune_views, views_need_prefer
 
 
 @dataclass
@@ -70,10 +70,13 @@ class OrthoContext:
     workers: int
     #: the run's own image store, used in this process; never pickled (workers open their own)
     store: ImageStore | None = field(default=None, compare=False)
+    #: visibility computed ahead in this process (:class:`ViewPrefetch`); never pickled
+    prefetch: ViewPrefetch | None = field(default=None, compare=False)
 
     def __getstate__(self):
         state = dict(self.__dict__)
         state["store"] = None
+        state["prefetch"] = None
         return state
 
     def store_key(self) -> tuple:
@@ -126,7 +129,10 @@ def ortho_tile_task(ctx: OrthoContext, task: OrthoTask):
     fixed = np.asarray(task.fixed).astype(np.int64)
     prefer = np.unique(fixed[fixed >= 0])
     threads = _threads(ctx)
-    views = tile_views(ctx.setup, ctx.surface, ctx.grid, tile, ctx.to_local, threads, prefer=prefer)
+    views = ctx.prefetch.take(tile) if ctx.prefetch is not None else None
+    if views is None:
+        views = all_tile_views(ctx.setup, ctx.surface, ctx.grid, tile, ctx.to_local, threads, prefer)
+    views = prune_views(views, ctx.setup, prefer)
     sl = tile.inner_slices
     n_samples = int(views.usable[:, sl[0], sl[1]].sum()) if len(views.cands) else 0
     dtype = np.dtype(ctx.dtype)
@@ -140,6 +146,67 @@ def ortho_tile_task(ctx: OrthoContext, task: OrthoTask):
     lab = np.ascontiguousarray(m.label[sl].astype(np.int16))
     occ = np.ascontiguousarray(m.occlusion[sl])
     return out, lab, occ, np.array([n_samples, views.triangles], np.int64)
+
+
+class ViewPrefetch:
+    """The visibility of coming tiles (:func:`~.views.all_tile_views`), computed ahead in one
+    background thread of this process.
+
+    A tile's visibility does not depend on its neighbours' labels (only the pruning of
+    :func:`~.views.prune_views` does), so the next wave's depth buffers can run while this wave
+    selects, blends and writes, and the first wave's while the colour statistics run: the cores
+    idle in those serial parts get work. :func:`ortho_tile_task` takes a tile's views from here
+    when they were submitted, and computes them itself otherwise; the result is the same either
+    way (the tile cache keys do not change). At most ``limit`` tiles' views wait here (memory:
+    one task's per-candidate arrays each, :func:`task_memory`). Not used with the lazy
+    ``views_per_cell`` order, which depends on the neighbours' labels.
+    """
+
+    def __init__(self, ctx: OrthoContext, limit: int = 2) -> None:
+        from concurrent.futures import ThreadPoolExecutor
+
+        self.ctx = ctx
+        self.limit = max(1, int(limit))
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="truortho-views")
+        self._futures: dict = {}
+        self.taken = 0
+
+    @staticmethod
+    def usable(setup: ViewSetup) -> bool:
+        return not views_need_prefer(setup)
+
+    def _compute(self, tile: Tile):
+        c = self.ctx
+        return all_tile_views(c.setup, c.surface, c.grid, tile, c.to_local, _threads(c))
+
+    def submit(self, tiles) -> None:
+        """Start the views of ``tiles`` (in order) while fewer than ``limit`` wait."""
+        for t in tiles:
+            if len(self._futures) >= self.limit:
+                break
+            if t.index not in self._futures:
+                self._futures[t.index] = self._pool.submit(self._compute, t)
+
+    def take(self, tile: Tile):
+        """The views of ``tile`` if submitted (waits for them; re-raises their error), else None."""
+        f = self._futures.pop(tile.index, None)
+        if f is None:
+            return None
+        self.taken += 1
+        return f.result()
+
+    def discard(self, tiles) -> None:
+        """Forget ``tiles`` (e.g. found in the tile cache, so never taken)."""
+        for t in tiles:
+            f = self._futures.pop(t.index, None)
+            if f is not None:
+                f.cancel()
+
+    def close(self) -> None:
+        for f in self._futures.values():
+            f.cancel()
+        self._futures.clear()
+        self._pool.shutdown(wait=True)
 
 
 def waves(tiles: list[Tile]) -> list[list[Tile]]:
@@ -228,6 +295,7 @@ def side_of(tile_size: int, overlap: int) -> int:
 __all__ = [
     "OrthoContext",
     "OrthoTask",
+    "ViewPrefetch",
     "tile_candidates",
     "tile_costs",
     "DoneLabels",

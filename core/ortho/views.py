@@ -27,6 +27,7 @@ is usable in every image whose frame contains its projection.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass
@@ -250,6 +251,9 @@ class TileViews:
     eff_res: np.ndarray
     gsd: np.ndarray
     triangles: int = 0
+    #: (K,) bool from :func:`all_tile_views`: among the ``top_views`` best of some cell (None after
+    #: :func:`prune_views`, or when every candidate stays)
+    top: np.ndarray | None = None
 
 
 def _normals(h: np.ndarray, res: float) -> np.ndarray:
@@ -348,8 +352,55 @@ def tile_views(
     """Visibility and view quality of the outer window of ``tile`` (module docstring).
 
     ``prefer``: image indices evaluated first on every cell (the images neighbouring tiles
-    already chose inside this window, so their roofs can continue here).
+    already chose inside this window, so their roofs can continue here); they stay candidates.
+
+    The same as :func:`prune_views` of :func:`all_tile_views`: the two halves can run apart
+    (the visibility before the neighbours' labels are known).
     """
+    return prune_views(all_tile_views(setup, surface, grid, tile, to_local, workers, prefer), setup, prefer)
+
+
+def views_need_prefer(setup: ViewSetup) -> bool:
+    """Whether :func:`all_tile_views` depends on ``prefer`` (the lazy ``views_per_cell`` order)."""
+    return setup.views_per_cell > 0
+
+
+def prune_views(views: TileViews, setup: ViewSetup, prefer=None) -> TileViews:
+    """Drop the candidates of :func:`all_tile_views` among the ``top_views`` best of no cell,
+    except the ``prefer`` images (their roofs continue from neighbouring tiles)."""
+    top = views.top
+    if top is None or setup.top_views <= 0 or len(views.cands) <= setup.top_views:
+        return dataclasses.replace(views, top=None)
+    best = top.copy()
+    if prefer is not None and len(prefer):
+        best |= np.isin(views.cands, np.asarray(prefer))
+    if best.all():
+        return dataclasses.replace(views, top=None)
+    sel = np.flatnonzero(best)
+    return dataclasses.replace(
+        views,
+        cands=views.cands[sel],
+        usable=views.usable[sel],
+        near_edge=views.near_edge[sel],
+        uv=views.uv[sel],
+        eff_res=views.eff_res[sel],
+        gsd=views.gsd[sel],
+        top=None,
+    )
+
+
+def all_tile_views(
+    setup: ViewSetup,
+    surface,
+    grid: RasterGrid,
+    tile: Tile,
+    to_local: PlanTransform,
+    workers: int = 1,
+    prefer=None,
+) -> TileViews:
+    """:func:`tile_views` before :func:`prune_views`: every candidate that sees a cell, with
+    ``top`` marking those among the ``top_views`` best of some cell. ``prefer`` matters here only
+    for the lazy order of ``views_per_cell`` (:func:`views_need_prefer`)."""
     res = grid.res
     outer = tile.outer_grid(grid)
     M = setup.margin_cells
@@ -518,25 +569,13 @@ def tile_views(
     eff = eff.reshape(K, rows, cols)
     gsd = gsd_all[keep]
     cands = cand_sorted[keep]
+    top = None
     if setup.top_views > 0 and K > setup.top_views:
-        # candidates among the best ``top_views`` of no cell are dropped: a cell starts from its best
-        # image (or its roof's), and a seam move only takes a neighbour's label; kept are also the
-        # images neighbouring tiles chose here (their roofs continue)
-        best = np.zeros(K, np.bool_)
-        _mark_top(eff, usable, int(setup.top_views), best)
-        if prefer is not None and len(prefer):
-            best |= np.isin(cands, np.asarray(prefer))
-        if not best.all():
-            sel = np.flatnonzero(best)
-            usable, edge, uv, eff, gsd, cands = (
-                usable[sel],
-                edge[sel],
-                uv[sel],
-                eff[sel],
-                gsd[sel],
-                cands[sel],
-            )
-    return TileViews(outer, h, cands, usable, edge, uv, eff, gsd, 0 if tris is None else len(tris))
+        # candidates among the best ``top_views`` of no cell are dropped (by prune_views): a cell
+        # starts from its best image (or its roof's), and a seam move only takes a neighbour's label
+        top = np.zeros(K, np.bool_)
+        _mark_top(eff, usable, int(setup.top_views), top)
+    return TileViews(outer, h, cands, usable, edge, uv, eff, gsd, 0 if tris is None else len(tris), top)
 
 
 @njit

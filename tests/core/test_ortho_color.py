@@ -136,3 +136,45 @@ def test_group_ids_equal_unique_and_stable_argsort():
             np.testing.assert_array_equal(inverse, inv2)
             np.testing.assert_array_equal(counts, c2)
             np.testing.assert_array_equal(order, np.argsort(inv2, kind="stable"))
+
+
+def test_thin_groups_keeps_evenly_spaced_members_of_every_group():
+    from truortho.core.ortho.color import _group_ids, _thin_groups
+
+    rng = np.random.default_rng(3)
+    ids = rng.integers(0, 40, 5000)
+    ids[ids == 7] = 8  # an absent group
+    _, inverse, counts, order = _group_ids(ids, 40)
+    for m in (1, 5, 50, 10_000):
+        sub = _thin_groups(counts, order, m)
+        assert np.all(np.diff(sub) > 0)  # ascending item indices, no repeats
+        kept = np.bincount(inverse[sub], minlength=len(counts))
+        assert np.array_equal(kept, np.minimum(counts, m))
+        for g in np.flatnonzero(counts > m)[:5]:  # spread over the group, not its head
+            members = np.flatnonzero(inverse == g)
+            pos = np.searchsorted(members, sub[inverse[sub] == g])
+            assert pos.min() < counts[g] / m + 1 and pos.max() >= counts[g] - counts[g] / m - 1
+
+
+def test_a_long_strip_of_images_keeps_every_image_pair():
+    """200 images in a strip, each cell seen by three neighbours: every image pair keeps its
+    evidence at a small per-pair bound, and the gains are recovered along the whole strip."""
+    rng = np.random.default_rng(5)
+    n_img, per_img = 200, 150
+    g_true = rng.uniform(0.85, 1.15, n_img)
+    g_true /= g_true.mean()
+    first = np.repeat(np.arange(n_img - 2), per_img)  # a cell in images first, first+1, first+2
+    x = rng.uniform(20, 80, len(first))
+    cells = np.repeat(np.arange(len(first)), 3)
+    imgs = (first[:, None] + np.arange(3)[None]).ravel()
+    vals = (np.repeat(x, 3) / g_true[imgs] + rng.normal(0, 0.3, len(imgs)))[:, None]
+    corr = estimate_corrections(cells, imgs, vals, n_img, per_pair=100)
+    assert corr.stats["image_pairs"] == (n_img - 1) + (n_img - 2)  # (i, i+1) and (i, i+2)
+    assert corr.stats["pairs_used"] <= 100 * corr.stats["image_pairs"]
+    # the strip is a chain, so errors accumulate along it: still a few per cent at its far end
+    err = np.abs(corr.gain[:, 0] - g_true).max()
+    assert err < 0.04
+    # the same number of pairs drawn at random over the block (a global cap) leaves some image
+    # pairs with fewer samples, and the chain is worse
+    glob = estimate_corrections(cells, imgs, vals, n_img, per_pair=0, max_pairs=corr.stats["pairs_used"])
+    assert np.abs(glob.gain[:, 0] - g_true).max() > 1.2 * err

@@ -171,3 +171,55 @@ def test_rerun_after_a_crash_resumes_from_the_finished_tiles(scene, reference, t
     assert r.stats["tile_cache"] == {"hits": 5, "written": 7}
     assert _same(_products(tmp_path), reference[0])
     assert not (tmp_path / "ortho.tif.tiles").exists()
+
+
+def test_views_computed_ahead_give_the_same_mosaic(scene, reference, tmp_path, monkeypatch):
+    """In this process the coming tiles' visibility runs ahead in a background thread
+    (``ViewPrefetch``); the products are bit-identical to computing it in the tile task."""
+    from truortho.core.ortho import tiles as T
+
+    taken: list[bool] = []
+    take = T.ViewPrefetch.take
+
+    def counting_take(self, tile):
+        v = take(self, tile)
+        taken.append(v is not None)
+        return v
+
+    monkeypatch.setattr(T.ViewPrefetch, "take", counting_take)
+    (tmp_path / "ahead").mkdir()
+    _run(scene, tmp_path / "ahead")
+    assert sum(taken) >= 3  # every wave but the tiles beyond the look-ahead bound
+    assert _same(_products(tmp_path / "ahead"), reference[0])
+    monkeypatch.setattr(T.ViewPrefetch, "usable", staticmethod(lambda setup: False))
+    taken.clear()
+    (tmp_path / "inline").mkdir()
+    _run(scene, tmp_path / "inline")
+    assert not taken
+    assert _same(_products(tmp_path / "inline"), reference[0])
+
+
+def test_prune_views_keeps_the_top_and_the_preferred_images():
+    from truortho.core.grid import RasterGrid
+    from truortho.core.ortho.views import TileViews, ViewSetup, prune_views
+
+    K, r, c = 5, 3, 4
+    g = RasterGrid.from_extent((0, 0, c, r), 1.0, None)
+    rng = np.random.default_rng(0)
+    v = TileViews(
+        g, np.zeros((r, c)), np.array([2, 4, 7, 9, 11]), rng.random((K, r, c)) > 0.3,
+        np.zeros((K, r, c), bool), rng.random((K, r, c, 2)).astype(np.float32),
+        rng.random((K, r, c)).astype(np.float32), np.arange(K, dtype=float), 10,
+        np.array([True, False, True, False, False]),
+    )  # fmt: skip
+    setup = ViewSetup([], [], np.zeros((0, 4)), 0.0, 1.0, 0.7, 0, True, 1.0, 1.0, 0.0, top_views=2)
+    p = prune_views(v, setup)
+    assert list(p.cands) == [2, 7] and p.top is None and p.triangles == 10
+    assert np.array_equal(p.uv, v.uv[[0, 2]]) and np.array_equal(p.usable, v.usable[[0, 2]])
+    p = prune_views(v, setup, prefer=np.array([9, 30]))
+    assert list(p.cands) == [2, 7, 9] and np.array_equal(p.eff_res, v.eff_res[[0, 2, 3]])
+    # no pruning pending, or no bound: unchanged
+    import dataclasses
+
+    assert list(prune_views(dataclasses.replace(v, top=None), setup).cands) == [2, 4, 7, 9, 11]
+    assert list(prune_views(v, dataclasses.replace(setup, top_views=0)).cands) == [2, 4, 7, 9, 11]
