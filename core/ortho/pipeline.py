@@ -460,8 +460,9 @@ def true_ortho(
 
         if in_process and ViewPrefetch.usable(setup):
             # the visibility of the coming tiles runs ahead in a background thread: the first
-            # wave's during the colour statistics, the next wave's during this one's mosaic
-            ctx.prefetch = ViewPrefetch(ctx, limit=workers)
+            # wave's during the colour statistics, the next wave's during this one's mosaic when
+            # the wave has fewer tiles than threads; one tile ahead
+            ctx.prefetch = ViewPrefetch(ctx, limit=1)
             stack.callback(ctx.prefetch.close)
             ctx.prefetch.submit(batches[0])
         # ---- colour correction
@@ -553,8 +554,10 @@ def true_ortho(
         n_done = 0
         for bi, wave in enumerate(batches):
             check(progress)
-            if ctx.prefetch is not None and bi + 1 < len(batches):
-                ctx.prefetch.submit(batches[bi + 1])
+            if ctx.prefetch is not None and bi + 1 < len(batches) and len(wave) < workers:
+                # fewer tiles than threads in this wave: a core would idle (with enough tiles the
+                # look-ahead only competed for the cores and held memory on the 4x bench scene)
+                ctx.prefetch.submit(batches[bi + 1], besides=wave)
             tasks = [OrthoTask(t, done.fixed(t)) for t in wave]
             wsub = SubProgress(sub, n_done / len(tiles), (n_done + len(wave)) / len(tiles))
             try:

@@ -162,7 +162,7 @@ class ViewPrefetch:
     ``views_per_cell`` order, which depends on the neighbours' labels.
     """
 
-    def __init__(self, ctx: OrthoContext, limit: int = 2) -> None:
+    def __init__(self, ctx: OrthoContext, limit: int = 1) -> None:
         from concurrent.futures import ThreadPoolExecutor
 
         self.ctx = ctx
@@ -179,10 +179,12 @@ class ViewPrefetch:
         c = self.ctx
         return all_tile_views(c.setup, c.surface, c.grid, tile, c.to_local, _threads(c))
 
-    def submit(self, tiles) -> None:
-        """Start the views of ``tiles`` (in order) while fewer than ``limit`` wait."""
+    def submit(self, tiles, besides=()) -> None:
+        """Start the views of ``tiles`` (in order) while fewer than ``limit`` wait, not counting
+        those of the tiles ``besides`` (the running wave's, about to be taken)."""
+        skip = {t.index for t in besides}
         for t in tiles:
-            if len(self._futures) >= self.limit:
+            if sum(1 for k in self._futures if k not in skip) >= self.limit:
                 break
             if t.index not in self._futures:
                 self._futures[t.index] = self._pool.submit(self._compute, t)
