@@ -188,9 +188,14 @@ def test_views_computed_ahead_give_the_same_mosaic(scene, reference, tmp_path, m
 
     monkeypatch.setattr(T.ViewPrefetch, "take", counting_take)
     (tmp_path / "ahead").mkdir()
-    _run(scene, tmp_path / "ahead")
-    assert sum(taken) >= 3  # every wave but the tiles beyond the look-ahead bound
+    _run(scene, tmp_path / "ahead")  # 2 threads, waves of >= 2 tiles: only the first wave looks ahead
+    assert sum(taken) == 1
     assert _same(_products(tmp_path / "ahead"), reference[0])
+    taken.clear()
+    (tmp_path / "ahead5").mkdir()
+    _run(scene, tmp_path / "ahead5", workers=5)  # waves of 4, 4, 2, 2 tiles: one tile of each ahead
+    assert sum(taken) == 4
+    assert _same(_products(tmp_path / "ahead5"), reference[0])
     monkeypatch.setattr(T.ViewPrefetch, "usable", staticmethod(lambda setup: False))
     taken.clear()
     (tmp_path / "inline").mkdir()
