@@ -257,7 +257,47 @@ class TileViews:
 
 
 def _normals(h: np.ndarray, res: float) -> np.ndarray:
-    """Unit normals (rows, cols, 3) from the smaller one-sided differences."""
+    """Unit normals (rows, cols, 3) from the smaller one-sided differences (the fwd one on a tie,
+    the other one where a neighbour has no height, flat where neither has)."""
+    out = np.empty(h.shape + (3,))
+    _normals_into(np.ascontiguousarray(h, np.float64), float(res), out)
+    return out
+
+
+@njit
+def _slope(hm, h0, hp):
+    """The smaller of the one-sided differences ``hp - h0`` (forward) and ``h0 - hm``; 0 when
+    neither is finite."""
+    f = hp - h0
+    b = h0 - hm
+    if not math.isfinite(f):
+        f = b
+    if not math.isfinite(b):
+        b = f
+    d = f if abs(f) <= abs(b) else b
+    return d if math.isfinite(d) else 0.0
+
+
+@njit
+def _normals_into(h, res, out):
+    rows, cols = h.shape
+    for r in range(rows):
+        for c in range(cols):
+            hm = h[r, c - 1] if c > 0 else np.nan
+            hp = h[r, c + 1] if c + 1 < cols else np.nan
+            dzdx = _slope(hm, h[r, c], hp) / res
+            hm = h[r - 1, c] if r > 0 else np.nan
+            hp = h[r + 1, c] if r + 1 < rows else np.nan
+            dzdy = -(_slope(hm, h[r, c], hp) / res)  # rows go south
+            nx, ny = -dzdx, -dzdy
+            norm = math.sqrt(nx * nx + ny * ny + 1.0)
+            out[r, c, 0] = nx / norm
+            out[r, c, 1] = ny / norm
+            out[r, c, 2] = 1.0 / norm
+
+
+def _normals_numpy(h: np.ndarray, res: float) -> np.ndarray:
+    """Reference of :func:`_normals` (tests)."""
     hz = np.where(np.isfinite(h), h, np.nan)
 
     def d(axis):
