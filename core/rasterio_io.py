@@ -265,6 +265,11 @@ class RasterWriter:
             )
         self._ds.write(a.astype(self.dtype, copy=False), window=Window(c0, r0, nc, nr))
 
+    def close(self) -> None:
+        """Finish the file now (overviews, COG copy, rename into place), as a successful exit of
+        the ``with`` block does; the exit after it does nothing more."""
+        self.__exit__(None, None, None)
+
     def __exit__(self, exc_type, exc, tb) -> None:
         ds, self._ds = self._ds, None
         try:
@@ -320,6 +325,7 @@ class RasterWriter:
             for p in (self._tmp, Path(str(self._tmp) + ".aux.xml"), Path(str(self._tmp) + ".ovr")):
                 with contextlib.suppress(FileNotFoundError):
                     p.unlink()
+            self._tmp = None
 
 
 def write_raster(path, data: np.ndarray, grid: RasterGrid, nodata=None, **options) -> Path:

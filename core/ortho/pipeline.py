@@ -46,7 +46,7 @@ from ..orientation import Orientation, as_orientation
 from ..parallel import Digest, InProcessExecutor, file_identity, make_executor, tile_run
 from ..progress import Progress, Steps, SubProgress, as_progress, check
 from .color import ColorCorrection, estimate_corrections, to_channels
-from .mosaic import ImageStore, MosaicParams, candidate_colours
+from .mosaic import ImageStore, MosaicParams, candidate_colours, each
 from .seams import dissolve, region_polygons
 from .surface import PlanTransform, open_surface, same_crs, transform_bounds
 from .tiles import (
@@ -595,9 +595,14 @@ def true_ortho(
             sub.update(n_done / len(tiles), f"tile {n_done}/{len(tiles)}")
         check(progress)
         steps[3].update(0.0, "writing overviews")
+        # the rasters' overviews and COG copies (GDAL, in threads) and the seamline polygons at once
+        dissolved: dict = {}
+        jobs = [w.close for w in (w_out, w_idx, w_occ) if w is not None]
+        jobs.append(lambda: dissolved.update(dissolve(parts)))
+        each(lambda job: job(), jobs, workers)
     stats["seconds_mosaic"] = round(time.perf_counter() - t0, 3)
     stats["tile_cache"] = {"hits": cache.hits, "written": cache.written}
-    regions = [SeamRegion(k, o.images[k].name, int(counts[k]), g) for k, g in dissolve(parts).items()]
+    regions = [SeamRegion(k, o.images[k].name, int(counts[k]), g) for k, g in dissolved.items()]
     stats.update(
         {
             "tiles": len(tiles),

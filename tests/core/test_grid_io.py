@@ -104,6 +104,30 @@ def test_cog_rgba(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ortho.tif"]  # no temporary left
 
 
+def test_writers_closed_early_in_threads_are_complete_and_leave_no_temporary(tmp_path):
+    """``close()`` finishes a raster inside its ``with`` block (the true ortho closes its three
+    rasters at once in threads); the exit after it changes nothing."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    g = RasterGrid(0.0, 600.0, 1.0, 600, 600, "EPSG:32632")
+    data = np.arange(600 * 600, dtype=np.float32).reshape(1, 600, 600)
+    paths = [tmp_path / f"r{i}.tif" for i in range(3)]
+    with RasterWriter(paths[0], g, 1, "float32", cog=True) as a, RasterWriter(
+        paths[1], g, 1, "float32", overviews=True
+    ) as b, RasterWriter(paths[2], g, 1, "float32") as c:
+        for w in (a, b, c):
+            w.write(data)
+        with ThreadPoolExecutor(3) as pool:
+            list(pool.map(lambda w: w.close(), (a, b, c)))
+        assert all(p.exists() for p in paths)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["r0.tif", "r1.tif", "r2.tif"]
+    for p in paths:
+        got, _, _ = read_raster(p)
+        np.testing.assert_array_equal(got, data[0])
+    with pytest.raises(InputError, match="outside its 'with' block"):
+        a.write(data)
+
+
 def test_read_onto_grid_reprojects(tmp_path):
     g = RasterGrid(500000.0, 5600100.0, 1.0, 100, 100, "EPSG:32632")
     X, Y = g.centres()
