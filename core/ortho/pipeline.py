@@ -595,11 +595,16 @@ def true_ortho(
             sub.update(n_done / len(tiles), f"tile {n_done}/{len(tiles)}")
         check(progress)
         steps[3].update(0.0, "writing overviews")
-        # the rasters' overviews and COG copies (GDAL, in threads) and the seamline polygons at once
+        # the seamline polygons while the rasters get their overviews and COG copies (one after
+        # the other: GDAL compresses in threads already, and two copies at once were no faster)
         dissolved: dict = {}
-        jobs = [w.close for w in (w_out, w_idx, w_occ) if w is not None]
-        jobs.append(lambda: dissolved.update(dissolve(parts)))
-        each(lambda job: job(), jobs, workers)
+
+        def close_rasters():
+            for w in (w_out, w_idx, w_occ):
+                if w is not None:
+                    w.close()
+
+        each(lambda job: job(), [close_rasters, lambda: dissolved.update(dissolve(parts))], workers)
     stats["seconds_mosaic"] = round(time.perf_counter() - t0, 3)
     stats["tile_cache"] = {"hits": cache.hits, "written": cache.written}
     regions = [SeamRegion(k, o.images[k].name, int(counts[k]), g) for k, g in dissolved.items()]
