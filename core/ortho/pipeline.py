@@ -122,7 +122,10 @@ class TrueOrthoConfig:
         Cells of the decimated grid used to estimate the colour correction.
     workers : int
         Threads in this process: the independent tiles of a wave run in this many threads, and
-        the per-image depth buffers of a tile too.
+        the per-image depth buffers of a tile too. With more than one (and the in-process
+        executor), one background thread computes the visibility of the next tile ahead
+        (:class:`~.tiles.ViewPrefetch`): during the colour statistics, and during a wave with
+        fewer tiles than threads.
     cog : bool
         Cloud-Optimized GeoTIFF layout (with overviews) for the rasters.
     executor : {"inprocess", "local", "scheduler"}
@@ -458,10 +461,11 @@ def true_ortho(
     with contextlib.ExitStack() as stack:
         from ..rasterio_io import RasterWriter
 
-        if in_process and ViewPrefetch.usable(setup):
+        if in_process and workers > 1 and ViewPrefetch.usable(setup):
             # the visibility of the coming tiles runs ahead in a background thread: the first
             # wave's during the colour statistics, the next wave's during this one's mosaic when
-            # the wave has fewer tiles than threads; one tile ahead
+            # the wave has fewer tiles than threads; one tile ahead (not with one thread: a
+            # single-threaded run stays on one core)
             ctx.prefetch = ViewPrefetch(ctx, limit=1)
             stack.callback(ctx.prefetch.close)
             ctx.prefetch.submit(batches[0])

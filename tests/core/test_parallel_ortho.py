@@ -196,6 +196,11 @@ def test_views_computed_ahead_give_the_same_mosaic(scene, reference, tmp_path, m
     _run(scene, tmp_path / "ahead5", workers=5)  # waves of 4, 4, 2, 2 tiles: one tile of each ahead
     assert sum(taken) == 4
     assert _same(_products(tmp_path / "ahead5"), reference[0])
+    taken.clear()
+    (tmp_path / "one").mkdir()
+    _run(scene, tmp_path / "one", workers=1)  # one thread: nothing runs ahead
+    assert not taken
+    assert _same(_products(tmp_path / "one"), reference[0])
     monkeypatch.setattr(T.ViewPrefetch, "usable", staticmethod(lambda setup: False))
     taken.clear()
     (tmp_path / "inline").mkdir()
