@@ -258,6 +258,7 @@ def estimate_corrections(
     seed: int = 0,
     min_pair: int = 30,
     per_pair: int = 2_000,
+    budget: int = 400_000,
 ) -> ColorCorrection:
     """Least-squares gains and offsets from multiply observed cells.
 
@@ -282,8 +283,12 @@ def estimate_corrections(
     per_pair : int
         At most this many observation pairs per image pair, evenly spaced in cell order (so
         spread over the overlap): the robust moments of a pair need no more (their standard
-        error is ~2 % of the spread at 2,000), and every image pair keeps its evidence however
-        many pairs a block has (a global cap would starve the pairs of a large block).
+        error is ~3 % of the spread at 2,000).
+    budget : int
+        About this many observation pairs in all: an image pair keeps at most ``budget / image
+        pairs`` of them (between 250 and ``per_pair``), so the cost stays bounded as blocks grow
+        while every image pair keeps its evidence (a global random draw would leave some pairs
+        of a large block with few samples).
 
     Returns
     -------
@@ -316,8 +321,12 @@ def estimate_corrections(
     stats["images_constrained"] = int(np.count_nonzero(np.bincount(np.concatenate([ia, ib]), minlength=n)))
     pair_id = ia * n + ib
     upairs, inverse, counts, order = _group_ids(pair_id, n * n)
-    if per_pair > 0 and counts.max() > per_pair:
-        sub = _thin_groups(counts, order, int(per_pair))
+    cap = int(per_pair) if per_pair > 0 else len(ii)
+    if budget > 0 and len(counts):
+        cap = min(cap, max(int(budget) // len(counts), 250))
+    stats["per_image_pair"] = cap
+    if cap > 0 and counts.max() > cap:
+        sub = _thin_groups(counts, order, cap)
         ii, jj, ia, ib = ii[sub], jj[sub], ia[sub], ib[sub]
         upairs, inverse, counts, order = _group_ids(ia * n + ib, n * n)
     stats["pairs_used"] = int(len(ii))

@@ -170,11 +170,16 @@ def test_a_long_strip_of_images_keeps_every_image_pair():
     vals = (np.repeat(x, 3) / g_true[imgs] + rng.normal(0, 0.3, len(imgs)))[:, None]
     corr = estimate_corrections(cells, imgs, vals, n_img, per_pair=100)
     assert corr.stats["image_pairs"] == (n_img - 1) + (n_img - 2)  # (i, i+1) and (i, i+2)
-    assert corr.stats["pairs_used"] <= 100 * corr.stats["image_pairs"]
+    assert corr.stats["pairs_used"] <= 100 * corr.stats["image_pairs"] and corr.stats["per_image_pair"] == 100
+    # the budget bounds the whole: 20,000 over 397 image pairs is 50 each, raised to the floor of 250
+    assert estimate_corrections(cells, imgs, vals, n_img, budget=20_000).stats["per_image_pair"] == 250
+    assert estimate_corrections(cells, imgs, vals, n_img, budget=200_000).stats["per_image_pair"] == 503
     # the strip is a chain, so errors accumulate along it: still a few per cent at its far end
     err = np.abs(corr.gain[:, 0] - g_true).max()
     assert err < 0.04
     # the same number of pairs drawn at random over the block (a global cap) leaves some image
     # pairs with fewer samples, and the chain is worse
-    glob = estimate_corrections(cells, imgs, vals, n_img, per_pair=0, max_pairs=corr.stats["pairs_used"])
+    glob = estimate_corrections(
+        cells, imgs, vals, n_img, per_pair=0, budget=0, max_pairs=corr.stats["pairs_used"]
+    )
     assert np.abs(glob.gain[:, 0] - g_true).max() > 1.2 * err
