@@ -155,6 +155,7 @@ def main(argv=None) -> int:
     ap.add_argument("--skip-inprocess", action="store_true")
     ap.add_argument("--stage", choices=("osgm", "ortho", "all"), default="all")
     ap.add_argument("--ortho-tile", type=int, default=512)
+    ap.add_argument("--keep", action="store_true", help="keep the temporary scene and products")
     args = ap.parse_args(argv)
 
     from truortho.core.parallel import LocalDaskExecutor
@@ -170,6 +171,11 @@ def main(argv=None) -> int:
     t = time.perf_counter()
     scene = make_scene(cfg)
     tmp = Path(tempfile.mkdtemp(prefix="bench_parallel_"))
+    if not args.keep:  # the scene and products (~100 MB) go when the run ends
+        import atexit
+        import shutil
+
+        atexit.register(shutil.rmtree, tmp, True)
     folder = tmp / "scene"
     folder.mkdir()
     scene.write(folder)

@@ -213,6 +213,7 @@ def main() -> int:
     ap.add_argument("--tile", type=int, default=512)
     ap.add_argument("--no-orthority", action="store_true")
     ap.add_argument("--surface", help="another DSM of the same scene (e.g. OSGM's) instead of the truth DSM")
+    ap.add_argument("--keep", action="store_true", help="keep the temporary scene and products")
     args = ap.parse_args()
     w, h = (int(v) for v in args.size.split("x"))
 
@@ -224,6 +225,11 @@ def main() -> int:
 
     cfg = SceneConfig(image_size=(w, h), focal_px=args.focal, seed=args.seed)
     work = tempfile.mkdtemp(prefix="bench-trueortho-")
+    if not args.keep:  # the scene and products (~100 MB) go when the run ends
+        import atexit
+        import shutil
+
+        atexit.register(shutil.rmtree, work, True)
     t = time.perf_counter()
     scene = make_scene(cfg)
     scene.write(work)
