@@ -40,6 +40,7 @@ candidates and RGB: 16 x 538^2 x 38 B = 176 MB.
 from __future__ import annotations
 
 import os
+import threading
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -169,6 +170,7 @@ class ViewPrefetch:
         self.limit = max(1, int(limit))
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="truortho-views")
         self._futures: dict = {}
+        self._lock = threading.Lock()  # tile threads take while the client submits
         self.taken = 0
 
     @staticmethod
@@ -183,31 +185,36 @@ class ViewPrefetch:
         """Start the views of ``tiles`` (in order) while fewer than ``limit`` wait, not counting
         those of the tiles ``besides`` (the running wave's, about to be taken)."""
         skip = {t.index for t in besides}
-        for t in tiles:
-            if sum(1 for k in self._futures if k not in skip) >= self.limit:
-                break
-            if t.index not in self._futures:
-                self._futures[t.index] = self._pool.submit(self._compute, t)
+        with self._lock:
+            for t in tiles:
+                if sum(1 for k in self._futures if k not in skip) >= self.limit:
+                    break
+                if t.index not in self._futures:
+                    self._futures[t.index] = self._pool.submit(self._compute, t)
 
     def take(self, tile: Tile):
         """The views of ``tile`` if submitted (waits for them; re-raises their error), else None."""
-        f = self._futures.pop(tile.index, None)
-        if f is None:
-            return None
-        self.taken += 1
+        with self._lock:
+            f = self._futures.pop(tile.index, None)
+            if f is None:
+                return None
+            self.taken += 1
         return f.result()
 
     def discard(self, tiles) -> None:
         """Forget ``tiles`` (e.g. found in the tile cache, so never taken)."""
-        for t in tiles:
-            f = self._futures.pop(t.index, None)
-            if f is not None:
-                f.cancel()
+        with self._lock:
+            for t in tiles:
+                f = self._futures.pop(t.index, None)
+                if f is not None:
+                    f.cancel()
 
     def close(self) -> None:
-        for f in self._futures.values():
-            f.cancel()
-        self._futures.clear()
+        """Drop what waits and end the thread (after the tile it may be computing)."""
+        with self._lock:
+            for f in self._futures.values():
+                f.cancel()
+            self._futures.clear()
         self._pool.shutdown(wait=True)
 
 

@@ -209,6 +209,24 @@ def test_views_computed_ahead_give_the_same_mosaic(scene, reference, tmp_path, m
     assert _same(_products(tmp_path / "inline"), reference[0])
 
 
+def test_an_error_in_the_look_ahead_reaches_the_caller_and_nothing_is_written(scene, tmp_path, monkeypatch):
+    import threading
+
+    from truortho.core.ortho import tiles as T
+
+    def failing(*args, **kwargs):
+        if threading.current_thread().name.startswith("truortho-views"):
+            raise MemoryError("simulated failure in the look-ahead thread")
+        return real(*args, **kwargs)
+
+    real = T.all_tile_views
+    monkeypatch.setattr(T, "all_tile_views", failing)
+    with pytest.raises(MemoryError, match="look-ahead"):
+        _run(scene, tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == []  # no product, no temporary, no scratch
+    assert not [t for t in threading.enumerate() if t.name.startswith("truortho-views")]
+
+
 def test_prune_views_keeps_the_top_and_the_preferred_images():
     from truortho.core.grid import RasterGrid
     from truortho.core.ortho.views import TileViews, ViewSetup, prune_views
