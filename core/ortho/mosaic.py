@@ -16,6 +16,7 @@ corrected radiometrically (:mod:`.color`), feathering across seams
 from __future__ import annotations
 
 import math
+import threading
 from collections import OrderedDict
 from dataclasses import dataclass
 
@@ -56,46 +57,65 @@ class ImageStore:
 
         #: read by windows (rasterio formats) instead of decoded whole
         self.windowed = [bool(windowed) and _use_rasterio(str(p)) for p in paths]
-        import threading
-
-        self._lock = threading.RLock()
+        self._lock = threading.RLock()  # guards the cache and counters, not the decoding
+        self._pending: dict = {}  # (image, level) being decoded -> Event set when done
 
     def get(self, i: int, level: int = 0) -> np.ndarray:
-        """The decoded image ``i`` at ``level`` (thread-safe: tiles may run in threads)."""
-        with self._lock:
-            return self._get(i, level)
+        """The decoded image ``i`` at ``level`` (thread-safe: tiles may run in threads).
+
+        Images decode in parallel: the lock guards only the cache, and a thread asking for an
+        image another thread is decoding waits for that one instead of decoding it again.
+        """
+        key = (int(i), int(level))
+        while True:
+            with self._lock:
+                if key in self._cache:
+                    self._cache.move_to_end(key)
+                    return self._cache[key]
+                waiting = self._pending.get(key)
+                if waiting is None:
+                    event = self._pending[key] = threading.Event()
+            if waiting is not None:
+                waiting.wait()
+                continue  # cached now (or failed there: then try here and raise the same error)
+            try:
+                img = self._load(i, level)
+                with self._lock:
+                    self._insert(key, img)
+                return img
+            finally:
+                with self._lock:
+                    self._pending.pop(key, None)
+                event.set()
 
     def __getstate__(self):
         state = dict(self.__dict__)
         state["_lock"] = None
+        state["_pending"] = {}
         state["_cache"] = OrderedDict()
         state["_bytes"] = 0
         return state
 
     def __setstate__(self, state) -> None:
-        import threading
-
         self.__dict__.update(state)
         self._lock = threading.RLock()
 
-    def _get(self, i: int, level: int = 0) -> np.ndarray:
-        key = (int(i), int(level))
-        if key in self._cache:
-            self._cache.move_to_end(key)
-            return self._cache[key]
+    def _load(self, i: int, level: int) -> np.ndarray:
+        """Decode image ``i`` (level 0) or halve its level ``level - 1`` (outside the lock)."""
         if level == 0:
             img = read_image_sized(self.paths[i], self.sizes[i])
-            self.reads += 1
             nb = 1 if img.ndim == 2 else img.shape[2]
             if nb != self.bands or img.dtype != self.dtype:
                 raise FormatError(
                     self.paths[i],
                     f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
                 )
+            with self._lock:
+                self.reads += 1
         else:
             import cv2
 
-            src = self._get(i, level - 1)
+            src = self.get(i, level - 1)
             h, w = src.shape[:2]
             nw, nh = max(1, (w + 1) // 2), max(1, (h + 1) // 2)
             if src.ndim == 3 and src.shape[2] > 4:
@@ -108,13 +128,15 @@ class ImageStore:
                 )
             else:
                 img = cv2.resize(src, (nw, nh), interpolation=cv2.INTER_AREA)
-        img = np.ascontiguousarray(img)
+        return np.ascontiguousarray(img)
+
+    def _insert(self, key, img: np.ndarray) -> None:
+        """Cache ``img`` (under the lock), evicting the least recently used beyond ``max_bytes``."""
         self._cache[key] = img
         self._bytes += img.nbytes
         while self._bytes > self.max_bytes and len(self._cache) > 1:
             _, old = self._cache.popitem(last=False)
             self._bytes -= old.nbytes
-        return img
 
     def level_size(self, i: int, level: int) -> tuple[int, int]:
         """(width, height) of image ``i`` at ``level`` (halvings rounded up)."""
@@ -159,7 +181,8 @@ class ImageStore:
                 self.paths[i],
                 f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
             )
-        self.window_reads += 1
+        with self._lock:
+            self.window_reads += 1
         return img
 
     def level_for(self, gsd: float, res: float) -> int:
