@@ -283,12 +283,12 @@ def estimate_corrections(
     per_pair : int
         At most this many observation pairs per image pair, evenly spaced in cell order (so
         spread over the overlap): the robust moments of a pair need no more (their standard
-        error is ~3 % of the spread at 2,000).
+        error is ~3 % of the spread at 2,000). 0: no bound.
     budget : int
         About this many observation pairs in all: an image pair keeps at most ``budget / image
         pairs`` of them (between 250 and ``per_pair``), so the cost stays bounded as blocks grow
         while every image pair keeps its evidence (a global random draw would leave some pairs
-        of a large block with few samples).
+        of a large block with few samples). 0: no budget.
 
     Returns
     -------
@@ -301,6 +301,9 @@ def estimate_corrections(
         raise InputError("estimate_corrections: observations must be (K,), (K,) and (K, channels)")
     nch = val.shape[1]
     n = int(n_images)
+    for name, v in (("max_pairs", max_pairs), ("per_pair", per_pair), ("budget", budget)):
+        if isinstance(v, bool) or not isinstance(v, int | np.integer) or v < 0:
+            raise InputError(f"estimate_corrections: {name} must be a non-negative integer, got {v!r}")
     if len(img) and (img.min() < 0 or img.max() >= n):
         raise InputError("estimate_corrections: image index out of range")
     ii, jj = _pairs(cell, max_pairs, seed)

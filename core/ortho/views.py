@@ -296,24 +296,6 @@ def _normals_into(h, res, out):
             out[r, c, 2] = 1.0 / norm
 
 
-def _normals_numpy(h: np.ndarray, res: float) -> np.ndarray:
-    """Reference of :func:`_normals` (tests)."""
-    hz = np.where(np.isfinite(h), h, np.nan)
-
-    def d(axis):
-        fwd = np.diff(hz, axis=axis, append=np.nan)
-        bwd = np.diff(hz, axis=axis, prepend=np.nan)
-        a = np.where(np.isnan(fwd), bwd, fwd)
-        b = np.where(np.isnan(bwd), fwd, bwd)
-        out = np.where(np.abs(a) <= np.abs(b), a, b)
-        return np.where(np.isfinite(out), out, 0.0) / res
-
-    dzdx = d(1)
-    dzdy = -d(0)  # rows go south
-    n = np.stack([-dzdx, -dzdy, np.ones_like(dzdx)], axis=-1)
-    return n / np.linalg.norm(n, axis=-1, keepdims=True)
-
-
 def edge_shift(h: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:
     """Unit plan vectors (rows, cols) ``(dx, dy)`` pointing away from neighbouring height discontinuities.
 
@@ -409,6 +391,10 @@ def prune_views(views: TileViews, setup: ViewSetup, prefer=None) -> TileViews:
     """Drop the candidates of :func:`all_tile_views` among the ``top_views`` best of no cell,
     except the ``prefer`` images (their roofs continue from neighbouring tiles)."""
     top = views.top
+    if top is not None and np.shape(top) != np.shape(views.cands):
+        raise InputError(
+            f"prune_views: top has shape {np.shape(top)}, the candidates {np.shape(views.cands)}"
+        )
     if top is None or setup.top_views <= 0 or len(views.cands) <= setup.top_views:
         return dataclasses.replace(views, top=None)
     best = top.copy()

@@ -4,7 +4,25 @@ from __future__ import annotations
 
 import numpy as np
 
-from truortho.core.ortho.views import _normals, _normals_numpy
+from truortho.core.ortho.views import _normals
+
+
+def _normals_numpy(h: np.ndarray, res: float) -> np.ndarray:
+    """The array formula the compiled normals replaced (the reference of the test below)."""
+    hz = np.where(np.isfinite(h), h, np.nan)
+
+    def d(axis):
+        fwd = np.diff(hz, axis=axis, append=np.nan)
+        bwd = np.diff(hz, axis=axis, prepend=np.nan)
+        a = np.where(np.isnan(fwd), bwd, fwd)
+        b = np.where(np.isnan(bwd), fwd, bwd)
+        out = np.where(np.abs(a) <= np.abs(b), a, b)
+        return np.where(np.isfinite(out), out, 0.0) / res
+
+    dzdx = d(1)
+    dzdy = -d(0)  # rows go south
+    n = np.stack([-dzdx, -dzdy, np.ones_like(dzdx)], axis=-1)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
 
 
 def test_compiled_normals_equal_the_array_formula():
