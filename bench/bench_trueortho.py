@@ -18,6 +18,10 @@ nadir block + 4 obliques, per-image exposure differences):
   block ortho also needs them mosaicked: ``gdal.BuildVRT`` over them on our grid (last image on
   top) + ``gdal.Translate`` to a COG with overviews like ours, timed in its own subprocess. The
   ratio of mosaic output rates compares like with like: the same cells and bands written;
+* **I/O floor**: only decoding the images (``ImageStore``, two threads) and writing ours' three
+  finished products again with the pipeline's writers (``open_products``: COG, overviews,
+  DEFLATE), best of three, nothing computed: the output rate no implementation writing these
+  products could beat on this machine;
 * **Orthority** (pip ``orthority``, installed into a throw-away virtual environment under
   ``$TMPDIR`` on first use, never into .venv): ``oty.Ortho.process`` of every image onto the same
   DSM at the same resolution, bilinear image and DEM interpolation, one ortho per image (what a
@@ -205,6 +209,46 @@ def orthority_nearest_nadir(scene, out_dir, grid):
     return rgb, np.isfinite(best)
 
 
+FLOOR = textwrap.dedent(
+    """
+    import contextlib, glob, json, resource, sys, time
+    from concurrent.futures import ThreadPoolExecutor
+    import numpy as np
+    from truortho.core.imagery import image_info
+    from truortho.core.ortho.mosaic import ImageStore
+    from truortho.core.ortho.pipeline import open_products
+    from truortho.core.rasterio_io import read_raster
+    folder, ours, workers = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    # the finished products of ours, read back (not timed)
+    a, grid, _ = read_raster(ours, band=None)
+    idx = read_raster(ours[:-4] + "_idx.tif")[0]
+    occ = read_raster(ours[:-4] + "_occ.tif")[0]
+    files = sorted(glob.glob(folder + "/img_*.png"))
+    infos = [image_info(f) for f in files]
+    best = None
+    for rep in range(3):
+        store = ImageStore(files, [(i.width, i.height) for i in infos], infos[0].bands, infos[0].dtype)
+        t = time.perf_counter()
+        with ThreadPoolExecutor(workers) as ex:  # decoding every image, in parallel as ours does
+            list(ex.map(store.get, range(len(files))))
+        t1 = time.perf_counter()
+        with contextlib.ExitStack() as stack:  # writing the three products as ours writes them
+            base = ours[:-4] + "_floor"
+            w_out, w_idx, w_occ = open_products(stack, grid, base + ".tif", base + "_idx.tif",
+                                                base + "_occ.tif", a.shape[0] - 1, a.dtype)
+            w_out.write(a)
+            w_idx.write(idx)
+            w_occ.write(occ)
+        t2 = time.perf_counter()
+        if best is None or t2 - t < best[0]:
+            best = (t2 - t, t1 - t, t2 - t1)
+    print(json.dumps({"seconds": best[0], "seconds_decode": best[1], "seconds_write": best[2],
+                      "cells": grid.rows * grid.cols, "bands": int(a.shape[0] - 1), "images": len(files),
+                      "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024}))
+    """
+)
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--size", default="640x480")
@@ -302,6 +346,12 @@ def main() -> int:
         ours_sps = ours["stats"]["cell_image_samples"] * ours["bands"] / ours["seconds"] / 1e6
         results["ours"]["sample_mpix_per_s"] = round(ours_sps, 3)
         results["ratio_sample_rate"] = round(ours_sps / results["orthority"]["valid_mpix_per_s"], 3)
+        # the floor: only decoding the images and writing the three products (best of three)
+        fl = run_json([py, "-P", "-c", FLOOR, work, os.path.join(work, "ours.tif"), "2"], env)
+        fl["mpix_per_s"] = round(fl["cells"] * fl["bands"] / fl["seconds"] / 1e6, 3)
+        results["io_floor"] = fl
+        o_rate = results["orthority"]["mpix_per_s"]
+        results["ratio_output_rate_io_floor"] = round(fl["mpix_per_s"] / o_rate, 3)
 
     print("\n| run | s | Mpx/s | peak MB | ghosting | shift (GSD) | coverage | mean dE |")
     print("|---|---|---|---|---|---|---|---|")
@@ -326,6 +376,13 @@ def main() -> int:
             f"finished mosaic of the block (same {ours['cells']} cells x {ours['bands']} bands): Orthority "
             f"{results['orthority']['seconds']:.2f} s + GDAL VRT/COG mosaic {mo['seconds']:.2f} s; "
             f"ratio of mosaic output rates ours / (Orthority + GDAL): {results['ratio_mosaic_rate']}"
+        )
+        fl = results["io_floor"]
+        print(
+            f"I/O floor (decoding the {fl['images']} images + writing the three products as ours does, "
+            f"nothing computed): {fl['seconds']:.3f} s ({fl['seconds_decode']:.3f} decode + "
+            f"{fl['seconds_write']:.3f} write); its output rate / Orthority's, all written pixels: "
+            f"{results['ratio_output_rate_io_floor']}"
         )
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
     name = "trueortho.json" if not args.surface else "trueortho_surface.json"

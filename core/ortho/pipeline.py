@@ -457,10 +457,7 @@ def true_ortho(
     counts = np.zeros(len(o.images), np.int64)
     n_seen = n_valid = n_occl = n_samples = 0
     out_path = Path(os.fspath(output))
-    names = [f"band {k + 1}" for k in range(bands)] + ["alpha"]
     with contextlib.ExitStack() as stack:
-        from ..rasterio_io import RasterWriter
-
         if in_process and workers > 1 and ViewPrefetch.usable(setup):
             # the visibility of the coming tiles runs ahead in a background thread: the first
             # wave's during the colour statistics, the next wave's during this one's mosaic when
@@ -498,50 +495,9 @@ def true_ortho(
             # in this process the tiles of a wave run in ``workers`` threads (they are independent)
             tile_executor = InProcessExecutor(threads=workers)
 
-        w_out = stack.enter_context(
-            RasterWriter(
-                out_path,
-                grid,
-                bands=bands + 1,
-                dtype=dtype,
-                nodata=None,
-                descriptions=names,
-                alpha=True,
-                overviews=True,
-                cog=cfg.cog,
-                photometric="RGB" if bands == 3 else "MINISBLACK",
-            )
+        w_out, w_idx, w_occ = open_products(
+            stack, grid, out_path, source_index, occlusion, bands, dtype, cfg.cog
         )
-        w_idx = None
-        if source_index is not None:
-            w_idx = stack.enter_context(
-                RasterWriter(
-                    source_index,
-                    grid,
-                    1,
-                    "int16",
-                    nodata=-1,
-                    overviews=True,
-                    overview_resampling="nearest",
-                    cog=cfg.cog,
-                    descriptions=["source image index"],
-                )
-            )
-        w_occ = None
-        if occlusion is not None:
-            w_occ = stack.enter_context(
-                RasterWriter(
-                    occlusion,
-                    grid,
-                    1,
-                    "uint8",
-                    nodata=255,
-                    overviews=True,
-                    overview_resampling="nearest",
-                    cog=cfg.cog,
-                    descriptions=["1 = seen by no image"],
-                )
-            )
         tri_max = 0
         done = DoneLabels(overlap)  # border strips of the labels of finished tiles
         img_bytes = max(w * h for w, h in (sizes[i] for i in relevant)) * bands * dtype.itemsize * 4 // 3
@@ -651,6 +607,70 @@ _NOT_IN_KEY = {
     "image_cache_mb",
     "cog",
 }
+
+
+def open_products(
+    stack: contextlib.ExitStack,
+    grid: RasterGrid,
+    output,
+    source_index,
+    occlusion,
+    bands: int,
+    dtype,
+    cog: bool = True,
+):
+    """The writers of the three raster products, entered on ``stack``: the ortho (``bands`` +
+    alpha, average overviews), the source index (int16, nodata -1) and the occlusion mask (uint8,
+    nodata 255), both with nearest overviews; ``None`` for a product not asked for. Each is
+    written to a temporary file and renamed into place when ``stack`` closes without error."""
+    from ..rasterio_io import RasterWriter
+
+    dtype = np.dtype(dtype)
+    names = [f"band {k + 1}" for k in range(bands)] + ["alpha"]
+    w_out = stack.enter_context(
+        RasterWriter(
+            output,
+            grid,
+            bands=bands + 1,
+            dtype=dtype,
+            nodata=None,
+            descriptions=names,
+            alpha=True,
+            overviews=True,
+            cog=cog,
+            photometric="RGB" if bands == 3 else "MINISBLACK",
+        )
+    )
+    w_idx = w_occ = None
+    if source_index is not None:
+        w_idx = stack.enter_context(
+            RasterWriter(
+                source_index,
+                grid,
+                1,
+                "int16",
+                nodata=-1,
+                overviews=True,
+                overview_resampling="nearest",
+                cog=cog,
+                descriptions=["source image index"],
+            )
+        )
+    if occlusion is not None:
+        w_occ = stack.enter_context(
+            RasterWriter(
+                occlusion,
+                grid,
+                1,
+                "uint8",
+                nodata=255,
+                overviews=True,
+                overview_resampling="nearest",
+                cog=cog,
+                descriptions=["1 = seen by no image"],
+            )
+        )
+    return w_out, w_idx, w_occ
 
 
 def _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs) -> str:
