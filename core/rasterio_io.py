@@ -82,6 +82,9 @@ def _crs_object(crs):
         raise CRSError(f"cannot use the CRS {str(crs)[:80]!r} for a raster: {exc}") from None
 
 
+#: the compressions :class:`RasterWriter` writes (``"jpeg"``: lossy, 8-bit, COG only)
+COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg", "none")
+
 _ZSTD: list[bool] = []
 
 
@@ -143,7 +146,11 @@ class RasterWriter:
     cog : bool
         Rewrite as a Cloud-Optimized GeoTIFF (implies overviews).
     compress : str
-        ``"deflate"`` (default), ``"lzw"``, ``"zstd"`` or ``"none"``.
+        ``"deflate"`` (default), ``"lzw"``, ``"zstd"``, ``"none"`` (lossless), or ``"jpeg"``
+        (lossy, 8-bit data and ``cog`` only; 3 bands are stored as YCbCr, and an alpha band
+        becomes the file's internal mask, as GDAL's COG driver does).
+    quality : int
+        JPEG quality (1-100) of ``compress="jpeg"``.
     block : int
         Internal tile size (a multiple of 16).
     """
@@ -163,6 +170,7 @@ class RasterWriter:
         cog: bool = False,
         compress: str = "deflate",
         block: int = 256,
+        quality: int = 90,
     ) -> None:
         self.path = _check_raster_path(path)
         if not isinstance(grid, RasterGrid):
@@ -178,6 +186,22 @@ class RasterWriter:
         self.descriptions = list(descriptions) if descriptions else None
         if self.descriptions is not None and len(self.descriptions) != bands:
             raise InputError(f"{self.path}: {len(self.descriptions)} band descriptions for {bands} bands")
+        compress = (compress or "none").lower()
+        if compress not in COMPRESSIONS:
+            raise InputError(f"{self.path}: compression {compress!r} is not one of {', '.join(COMPRESSIONS)}")
+        if compress == "zstd" and not _has_zstd():
+            raise InputError(f"{self.path}: this GDAL cannot write ZSTD; use 'deflate' or 'lzw'")
+        if compress == "jpeg":
+            if self.dtype != np.uint8:
+                raise InputError(
+                    f"{self.path}: JPEG compression needs 8-bit data, got {self.dtype.name}; "
+                    "use a lossless compression ('deflate', 'zstd' or 'lzw')"
+                )
+            if not cog:
+                raise InputError(f"{self.path}: JPEG compression is written in the COG layout only")
+            if isinstance(quality, bool) or not isinstance(quality, int) or not 1 <= quality <= 100:
+                raise InputError(f"{self.path}: JPEG quality must be an integer in [1, 100], got {quality!r}")
+        self.quality = quality
         self.overviews = overviews or cog
         self.overview_resampling = overview_resampling
         self.cog = cog
@@ -196,19 +220,20 @@ class RasterWriter:
             "blockysize": block,
             "BIGTIFF": "IF_SAFER",
         }
-        if compress and compress.lower() != "none":
+        if compress != "none":
             self.profile["compress"] = compress
-            if compress.lower() in ("deflate", "lzw", "zstd"):
+            if compress in ("deflate", "lzw", "zstd"):
                 self.profile["predictor"] = 3 if self.dtype.kind == "f" else 2
             self.profile["num_threads"] = "ALL_CPUS"  # GDAL compresses blocks in threads
             if cog:
                 # the temporary file is read once by the COG copy, which compresses again: the
-                # fastest codec this GDAL has (ZSTD level 1, else DEFLATE level 1)
+                # fastest lossless codec this GDAL has (ZSTD level 1, else DEFLATE level 1)
+                self.profile["predictor"] = 3 if self.dtype.kind == "f" else 2
                 if _has_zstd():
                     self.profile["compress"] = "zstd"
                     self.profile["zstd_level"] = 1
-                    self.profile["predictor"] = 3 if self.dtype.kind == "f" else 2
-                elif compress.lower() == "deflate":
+                else:
+                    self.profile["compress"] = "deflate"
                     self.profile["zlevel"] = 1
         if photometric is None and self.dtype == np.uint8 and bands in (3, 4):
             photometric = "RGB"
@@ -304,13 +329,15 @@ class RasterWriter:
         assert self._tmp is not None
         cog_tmp = self._tmp.with_name(self._tmp.stem + ".cog" + self._tmp.suffix)
         opts = {
-            "compress": (self.compress or "none").upper(),
+            "compress": self.compress.upper(),
             "BIGTIFF": "IF_SAFER",
             "blocksize": self.profile["blockxsize"],
             "overview_resampling": self.overview_resampling.upper(),
         }
-        if "predictor" in self.profile:
+        if self.compress in ("deflate", "lzw", "zstd"):
             opts["predictor"] = "YES"
+        elif self.compress == "jpeg":
+            opts["quality"] = str(self.quality)  # RGB(A) -> YCbCr (+ mask from the alpha band)
         if "num_threads" in self.profile:
             opts["num_threads"] = "ALL_CPUS"
         try:

@@ -128,6 +128,14 @@ class TrueOrthoConfig:
         fewer tiles than threads.
     cog : bool
         Cloud-Optimized GeoTIFF layout (with overviews) for the rasters.
+    compression : {"deflate", "zstd", "lzw", "jpeg"}
+        Compression of the orthophoto. The first three are lossless (ZSTD writes fastest, DEFLATE
+        is read by every GIS). ``"jpeg"`` is lossy, for 8-bit images only and with ``cog``:
+        RGB is stored as YCbCr at ``jpeg_quality`` and the alpha band becomes the file's internal
+        mask; about a fifth of the size. The source index and the occlusion mask always stay
+        lossless (DEFLATE when ``"jpeg"``).
+    jpeg_quality : int
+        JPEG quality, 1-100.
     executor : {"inprocess", "local", "scheduler"}
         Where the mosaic tiles run (:mod:`truortho.core.parallel`; the colour statistics, on a
         decimated grid, always run here). Tiles run in four waves (:mod:`.tiles`); the mosaic is
@@ -164,6 +172,8 @@ class TrueOrthoConfig:
     color_cells: int = 60_000
     workers: int = 2
     cog: bool = True
+    compression: str = "deflate"
+    jpeg_quality: int = 90
     executor: str = "inprocess"
     scheduler_address: str | None = None
     dask_workers: int | None = None
@@ -205,10 +215,24 @@ class TrueOrthoConfig:
                 bad(name, "must not be negative")
         if self.extent is not None and len(self.extent) != 4:
             bad("extent", "expected (xmin, ymin, xmax, ymax)")
+        if self.compression not in ORTHO_COMPRESSIONS:
+            bad("compression", f"expected one of {', '.join(ORTHO_COMPRESSIONS)}")
+        if self.compression == "jpeg" and not self.cog:
+            bad("compression", "JPEG is written in the COG layout only (cog=True)")
+        if (
+            isinstance(self.jpeg_quality, bool)
+            or not isinstance(self.jpeg_quality, int)
+            or not 1 <= self.jpeg_quality <= 100
+        ):
+            bad("jpeg_quality", "expected an integer in [1, 100]")
         from ..parallel import EXECUTORS
 
         if self.executor not in EXECUTORS:
             bad("executor", f"expected one of {', '.join(EXECUTORS)}")
+
+
+#: compressions of the orthophoto (:attr:`TrueOrthoConfig.compression`)
+ORTHO_COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg")
 
 
 @dataclass
@@ -406,6 +430,16 @@ def true_ortho(
     # only relevant images are candidates
     setup.boxes[np.setdiff1d(np.arange(len(o.images)), relevant)] = np.nan
     bands, dtype = first.bands, np.dtype(first.dtype)
+    if cfg.compression == "jpeg" and dtype != np.uint8:
+        raise InputError(
+            f"compression: JPEG needs 8-bit images, but {first.path} is {dtype.name}; "
+            "use a lossless compression ('deflate', 'zstd' or 'lzw')"
+        )
+    if cfg.compression == "zstd":
+        from ..rasterio_io import _has_zstd
+
+        if not _has_zstd():
+            raise InputError("compression: this GDAL cannot write ZSTD; use 'deflate' or 'lzw'")
     sizes = [(c.width, c.height) for c in setup.cameras]
     store = ImageStore(paths, sizes, bands, dtype, cfg.image_cache_mb << 20)
     params = MosaicParams(
@@ -496,7 +530,16 @@ def true_ortho(
             tile_executor = InProcessExecutor(threads=workers)
 
         w_out, w_idx, w_occ = open_products(
-            stack, grid, out_path, source_index, occlusion, bands, dtype, cfg.cog
+            stack,
+            grid,
+            out_path,
+            source_index,
+            occlusion,
+            bands,
+            dtype,
+            cfg.cog,
+            cfg.compression,
+            cfg.jpeg_quality,
         )
         tri_max = 0
         done = DoneLabels(overlap)  # border strips of the labels of finished tiles
@@ -606,6 +649,8 @@ _NOT_IN_KEY = {
     "workers",
     "image_cache_mb",
     "cog",
+    "compression",
+    "jpeg_quality",
 }
 
 
@@ -618,14 +663,18 @@ def open_products(
     bands: int,
     dtype,
     cog: bool = True,
+    compression: str = "deflate",
+    jpeg_quality: int = 90,
 ):
     """The writers of the three raster products, entered on ``stack``: the ortho (``bands`` +
-    alpha, average overviews), the source index (int16, nodata -1) and the occlusion mask (uint8,
-    nodata 255), both with nearest overviews; ``None`` for a product not asked for. Each is
-    written to a temporary file and renamed into place when ``stack`` closes without error."""
+    alpha, average overviews, ``compression``), the source index (int16, nodata -1) and the
+    occlusion mask (uint8, nodata 255), both lossless with nearest overviews; ``None`` for a
+    product not asked for. Each is written to a temporary file and renamed into place when
+    ``stack`` closes without error."""
     from ..rasterio_io import RasterWriter
 
     dtype = np.dtype(dtype)
+    lossless = "deflate" if compression == "jpeg" else compression
     names = [f"band {k + 1}" for k in range(bands)] + ["alpha"]
     w_out = stack.enter_context(
         RasterWriter(
@@ -639,6 +688,8 @@ def open_products(
             overviews=True,
             cog=cog,
             photometric="RGB" if bands == 3 else "MINISBLACK",
+            compress=compression,
+            quality=jpeg_quality,
         )
     )
     w_idx = w_occ = None
@@ -653,6 +704,7 @@ def open_products(
                 overviews=True,
                 overview_resampling="nearest",
                 cog=cog,
+                compress=lossless,
                 descriptions=["source image index"],
             )
         )
@@ -667,6 +719,7 @@ def open_products(
                 overviews=True,
                 overview_resampling="nearest",
                 cog=cog,
+                compress=lossless,
                 descriptions=["1 = seen by no image"],
             )
         )

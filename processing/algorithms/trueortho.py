@@ -12,6 +12,7 @@ from qgis.core import (
     QgsProcessingException,
     QgsProcessingParameterBoolean,
     QgsProcessingParameterCrs,
+    QgsProcessingParameterEnum,
     QgsProcessingParameterExtent,
     QgsProcessingParameterFeatureSink,
     QgsProcessingParameterFile,
@@ -50,6 +51,10 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     MAX_VIEW_ANGLE = "MAX_VIEW_ANGLE"
     BLEND_WIDTH = "BLEND_WIDTH"
     TILE_SIZE = "TILE_SIZE"
+    COMPRESSION = "COMPRESSION"
+    JPEG_QUALITY = "JPEG_QUALITY"
+    #: COMPRESSION's options, in order (TrueOrthoConfig.compression)
+    COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg")
     EXECUTOR = "EXECUTOR"
     SCHEDULER_ADDRESS = "SCHEDULER_ADDRESS"
     OUTPUT = "OUTPUT"
@@ -116,6 +121,30 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             ),
             advanced=True,
         )
+        self.add(
+            QgsProcessingParameterEnum(
+                self.COMPRESSION,
+                tr("Compression of the orthophoto"),
+                options=[
+                    tr("DEFLATE (lossless, read by every GIS)"),
+                    tr("ZSTD (lossless, fastest to write)"),
+                    tr("LZW (lossless)"),
+                    tr("JPEG (lossy, 8-bit images only; alpha becomes a mask)"),
+                ],
+                defaultValue=0,
+            )
+        )
+        self.add(
+            QgsProcessingParameterNumber(
+                self.JPEG_QUALITY,
+                tr("JPEG quality"),
+                QgsProcessingParameterNumber.Integer,
+                90,
+                minValue=1,
+                maxValue=100,
+            ),
+            advanced=True,
+        )
         self.add_executor()
         self.add(QgsProcessingParameterRasterDestination(self.OUTPUT, tr("True orthophoto")))
         self.add(
@@ -165,6 +194,8 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             max_view_angle=self.parameterAsDouble(parameters, self.MAX_VIEW_ANGLE, context),
             blend_width=self.parameterAsInt(parameters, self.BLEND_WIDTH, context),
             tile_size=self.parameterAsInt(parameters, self.TILE_SIZE, context),
+            compression=self.COMPRESSIONS[self.parameterAsEnum(parameters, self.COMPRESSION, context)],
+            jpeg_quality=self.parameterAsInt(parameters, self.JPEG_QUALITY, context),
             # true_ortho makes the executor from these and closes it at the end
             executor=executor_kind,
             scheduler_address=address,

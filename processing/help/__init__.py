@@ -260,6 +260,11 @@ HELP: dict[str, dict] = {
             "a cell; also bounds how far outside a tile occluders are searched.",
             "BLEND_WIDTH": "Width of the feathering across seamlines, in cells (0 = hard seams).",
             "TILE_SIZE": "Tile side in cells; memory grows with its square and the images per tile.",
+            "COMPRESSION": "Compression of the orthophoto. DEFLATE (the default), ZSTD and LZW are "
+            "lossless; ZSTD writes fastest, DEFLATE is read by every GIS. JPEG is lossy (about a fifth of "
+            "the size), for 8-bit images only: RGB is stored as YCbCr and the alpha band becomes the "
+            "file's internal mask. The source index and occlusion mask always stay lossless.",
+            "JPEG_QUALITY": "JPEG quality (1-100) when COMPRESSION is JPEG.",
             "EXECUTOR": "Where the tiles of the mosaic are computed; the true orthophoto, source index, "
             "occlusion mask and seamlines are identical with every choice. inprocess: in QGIS's process, "
             "the independent tiles of a wave in parallel threads (the default). local: a Dask cluster of "
@@ -272,8 +277,8 @@ HELP: dict[str, dict] = {
             "plus '.tiles') until the run succeeds, so a rerun with the same inputs and parameters after a "
             "crash reuses them.",
             "SCHEDULER_ADDRESS": _SCHEDULER_HELP,
-            "OUTPUT": "GeoTIFF with the images' bands and data type plus an alpha band, tiled, with "
-            "overviews, Cloud-Optimized GeoTIFF layout.",
+            "OUTPUT": "GeoTIFF with the images' bands and data type plus an alpha band (an internal mask "
+            "with JPEG compression), tiled, with overviews, Cloud-Optimized GeoTIFF layout.",
             "SOURCE_INDEX": "Int16 GeoTIFF: index (0-based, orientation order) of the image each cell "
             "comes from; -1 = nodata.",
             "OCCLUSION": "UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the "

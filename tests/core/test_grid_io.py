@@ -104,6 +104,67 @@ def test_cog_rgba(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["ortho.tif"]  # no temporary left
 
 
+@pytest.mark.parametrize("compress", ["zstd", "lzw", "none"])
+def test_cog_lossless_compressions_keep_every_value(tmp_path, compress):
+    from truortho.core.rasterio_io import _has_zstd
+
+    if compress == "zstd" and not _has_zstd():
+        pytest.skip("this GDAL has no ZSTD")
+    g = RasterGrid(0.0, 600.0, 1.0, 600, 600, "EPSG:32632")
+    rng = np.random.default_rng(2)
+    rgba = rng.integers(0, 256, (4, 600, 600), dtype=np.uint8)
+    out = tmp_path / "o.tif"
+    write_raster(out, rgba, g, alpha=True, cog=True, compress=compress)
+    import rasterio
+
+    with rasterio.open(out) as ds:
+        assert (ds.compression.name.lower() if ds.compression else "none") == compress
+        assert ds.tags(ns="IMAGE_STRUCTURE").get("LAYOUT") == "COG" and ds.count == 4
+        np.testing.assert_array_equal(ds.read(), rgba)
+
+
+def test_cog_jpeg_turns_alpha_into_a_mask(tmp_path):
+    import rasterio
+
+    g = RasterGrid(0.0, 600.0, 1.0, 600, 600, "EPSG:32632")
+    yy, xx = np.mgrid[0:600, 0:600]
+    rng = np.random.default_rng(5)
+    tex = 60 * np.sin(xx / 7.0) * np.cos(yy / 5.0) + rng.normal(0, 3, xx.shape)  # texture + noise
+    rgba = np.stack(
+        [np.clip(90 + tex + xx * 0.1, 0, 255), np.clip(120 + tex, 0, 255), np.clip(140 - tex, 0, 255),
+         np.where((xx - 300) ** 2 + (yy - 300) ** 2 < 250**2, 255, 0)]
+    ).astype(np.uint8)  # fmt: skip
+    sizes = {}
+    for comp in ("deflate", "jpeg"):
+        out = tmp_path / f"{comp}.tif"
+        write_raster(out, rgba, g, alpha=True, cog=True, compress=comp, quality=85)
+        sizes[comp] = out.stat().st_size
+    with rasterio.open(tmp_path / "jpeg.tif") as ds:
+        assert ds.count == 3 and ds.compression.name.lower() == "jpeg" and ds.photometric.name == "ycbcr"
+        assert ds.tags(ns="IMAGE_STRUCTURE").get("LAYOUT") == "COG" and ds.overviews(1)
+        valid = rgba[3] > 0
+        np.testing.assert_array_equal(ds.dataset_mask() > 0, valid)
+        got = ds.read().astype(int)
+    err = np.abs(got - rgba[:3].astype(int))[:, valid]
+    print("JPEG error mean", err.mean(), "p99", np.percentile(err, 99), sizes)
+    assert err.mean() < 4.0 and np.percentile(err, 99) <= 15  # lossy (noise sigma 3), but close
+    assert sizes["jpeg"] < sizes["deflate"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["deflate.tif", "jpeg.tif"]
+
+
+def test_writer_rejects_bad_compressions(tmp_path):
+    g = RasterGrid(0.0, 64.0, 1.0, 64, 64, "EPSG:32632")
+    with pytest.raises(InputError, match="JPEG compression needs 8-bit data, got uint16"):
+        RasterWriter(tmp_path / "a.tif", g, 1, "uint16", cog=True, compress="jpeg")
+    with pytest.raises(InputError, match="COG layout only"):
+        RasterWriter(tmp_path / "a.tif", g, 4, "uint8", compress="jpeg")
+    with pytest.raises(InputError, match="JPEG quality must be an integer in \\[1, 100\\], got 0"):
+        RasterWriter(tmp_path / "a.tif", g, 3, "uint8", cog=True, compress="jpeg", quality=0)
+    with pytest.raises(InputError, match="'webp' is not one of deflate, zstd, lzw, jpeg, none"):
+        RasterWriter(tmp_path / "a.tif", g, 3, "uint8", compress="webp")
+    assert not list(tmp_path.iterdir())
+
+
 def test_writers_closed_early_in_threads_are_complete_and_leave_no_temporary(tmp_path):
     """``close()`` finishes a raster inside its ``with`` block (the true ortho closes its three
     rasters at once in threads); the exit after it changes nothing."""

@@ -131,6 +131,47 @@ def test_outputs_are_cogs_with_index_occlusion_and_seamlines(data):
         assert c.max() >= 0.99 * c.sum(), (k, c)
 
 
+def test_compressions_keep_the_mosaic(data):
+    """ZSTD and LZW store the very same mosaic; JPEG stores it lossy, with the alpha band as the
+    file's mask, and leaves the source index and occlusion mask lossless and unchanged."""
+    import rasterio
+
+    from truortho.core.rasterio_io import _has_zstd
+
+    ext = data["scene"].extent_world()
+    sub = (ext[0] + 20, ext[1] + 20, ext[0] + 80, ext[1] + 70)
+    kw = dict(color_correction=False, extent=sub, tile_size=128)
+    ref = _run(data, "c_deflate", **kw)
+    a_ref, _, _ = read_raster(ref.output, band=None)
+    idx_ref, _, _ = read_raster(ref.source_index)
+    for comp in ("zstd", "lzw") if _has_zstd() else ("lzw",):
+        r = _run(data, f"c_{comp}", compression=comp, **kw)
+        with rasterio.open(r.output) as ds:
+            assert ds.compression.name.lower() == comp
+            np.testing.assert_array_equal(ds.read(), a_ref)
+    r = _run(data, "c_jpeg", compression="jpeg", jpeg_quality=90, **kw)
+    with rasterio.open(r.output) as ds:
+        assert ds.count == 3 and ds.compression.name.lower() == "jpeg"
+        assert ds.tags(ns="IMAGE_STRUCTURE").get("LAYOUT") == "COG"
+        valid = a_ref[3] > 0
+        np.testing.assert_array_equal(ds.dataset_mask() > 0, valid)
+        rgb = ds.read()
+    for p in (r.source_index, r.occlusion):
+        with rasterio.open(p) as ds:
+            assert ds.compression.name.lower() == "deflate"
+    np.testing.assert_array_equal(read_raster(r.source_index)[0], idx_ref)
+    diff = np.abs(rgb.astype(int) - a_ref[:3].astype(int))[:, valid]
+    assert 0 < diff.mean() < 4.0  # lossy, close
+    dE = ev.mean_delta_e(np.moveaxis(rgb, 0, -1), np.moveaxis(a_ref[:3], 0, -1), valid)
+    assert dE < 5.0  # YCbCr 4:2:0 at quality 90 on a synthetic texture: 3.9 when written
+    assert r.output.stat().st_size < 0.5 * ref.output.stat().st_size
+    with pytest.raises(InputError, match="compression: expected one of deflate, zstd, lzw, jpeg"):
+        _run(data, "c_bad", compression="webp", **kw)
+    with pytest.raises(InputError, match="jpeg_quality"):
+        _run(data, "c_bad", compression="jpeg", jpeg_quality=101, **kw)
+    assert not list(data["folder"].glob("c_bad*"))
+
+
 def test_tiles_do_not_change_the_result(data):
     big = _run(data, "t512", color_correction=False, blend_width=3)
     small = _run(data, "t96", color_correction=False, blend_width=3, tile_size=96)
@@ -269,6 +310,10 @@ def test_single_band_16_bit_and_float_keep_dtype_and_bands(data, tmp_path):
             images.append(dataclasses.replace(im, path=name))
         o2 = dataclasses.replace(o, images=images, image_root=str(root))
         ext = data["scene"].extent_world()
+        with pytest.raises(InputError, match=f"JPEG needs 8-bit images, but .*img_000.tif is {dtype}"):
+            jpeg = TrueOrthoConfig(compression="jpeg")
+            true_ortho(o2, data["folder"] / "dsm.tif", tmp_path / "j.tif", config=jpeg)
+        assert not (tmp_path / "j.tif").exists()
         cfg = TrueOrthoConfig(extent=(ext[0] + 30, ext[1] + 30, ext[0] + 70, ext[1] + 60), tile_size=64)
         r = true_ortho(o2, data["folder"] / "dsm.tif", tmp_path / f"{dtype}.tif", config=cfg)
         with rasterio.open(r.output) as ds:

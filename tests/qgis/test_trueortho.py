@@ -39,6 +39,10 @@ def test_trueortho_executor_parameters(truortho_provider):
     assert address.flags() & QgsProcessingParameterDefinition.FlagOptional
     for p in (executor, address):
         assert p.flags() & QgsProcessingParameterDefinition.FlagAdvanced, p.name()
+    comp = alg.parameterDefinition("COMPRESSION")
+    assert [o.split(" ")[0] for o in comp.options()] == ["DEFLATE", "ZSTD", "LZW", "JPEG"]
+    assert comp.defaultValue() == 0 and not comp.flags() & QgsProcessingParameterDefinition.FlagAdvanced
+    assert alg.parameterDefinition("JPEG_QUALITY").defaultValue() == 90
 
 
 def test_trueortho_outputs(truortho_provider, scene_dir, tmp_path):
@@ -86,12 +90,21 @@ def test_trueortho_extent_and_crs(truortho_provider, scene_dir, tmp_path):
             "RESOLUTION": 0.5,
             "CRS": "EPSG:25832",
             "COLOR_CORRECTION": False,
+            "COMPRESSION": 3,  # JPEG
+            "JPEG_QUALITY": 80,
             "OUTPUT": str(tmp_path / "o25832.tif"),
         }
     )
     lyr = QgsRasterLayer(res["OUTPUT"], "o")
     assert lyr.crs().authid() == "EPSG:25832"
     assert lyr.width() == pytest.approx(80, abs=2) and lyr.height() == pytest.approx(60, abs=2)
+    # JPEG: RGB as YCbCr, the alpha band became the internal mask
+    import rasterio
+
+    with rasterio.open(res["OUTPUT"]) as ds:
+        assert ds.count == 3 and ds.compression.name.lower() == "jpeg" and ds.photometric.name == "ycbcr"
+        assert ds.mask_flag_enums[0] == [rasterio.enums.MaskFlags.per_dataset]
+        assert (ds.dataset_mask() > 0).mean() > 0.9
 
 
 def test_trueortho_bad_input(truortho_provider, scene_dir, tmp_path):
