@@ -4,6 +4,7 @@ Not a test. Run from the repository root with the project's interpreter::
 
     source scripts/env.sh
     python -P bench/bench_trueortho.py [--size 640x480] [--focal 800] [--seed 3] [--tile 512]
+        [--compress deflate|zstd|lzw|jpeg]
 
 What is measured, in one run on the same synthetic scene (``core/synthetic``: buildings, a tower,
 nadir block + 4 obliques, per-image exposure differences):
@@ -64,7 +65,8 @@ OURS = textwrap.dedent(
     folder, out, res, tile, vis, warm = sys.argv[1], sys.argv[2], float(sys.argv[3]), int(sys.argv[4]), \\
         sys.argv[5] == "1", sys.argv[6] == "1"
     dsm, extent = sys.argv[7], tuple(float(v) for v in sys.argv[8].split(","))
-    cfg = TrueOrthoConfig(resolution=res, tile_size=tile, visibility=vis, extent=extent)
+    cfg = TrueOrthoConfig(resolution=res, tile_size=tile, visibility=vis, extent=extent,
+                          compression=sys.argv[9])
     if warm:
         true_ortho(folder + "/orientation.json", dsm, out, config=cfg)
     t = time.perf_counter()
@@ -149,11 +151,14 @@ def run_json(cmd: list[str], env=None) -> dict:
 
 
 def quality(scene, path, grid, truth, buildings, seen) -> dict:
+    import rasterio
+
     from truortho.core.rasterio_io import read_raster
 
     a, _, _ = read_raster(path, band=None)
     rgb = np.moveaxis(a[:3], 0, -1)
-    valid = a[3] > 0
+    with rasterio.open(path) as ds:
+        valid = ds.dataset_mask() > 0  # the alpha band, or the mask of a JPEG output
     return _quality(rgb, valid, truth, buildings, seen)
 
 
@@ -218,9 +223,13 @@ FLOOR = textwrap.dedent(
     from truortho.core.ortho.mosaic import ImageStore
     from truortho.core.ortho.pipeline import open_products
     from truortho.core.rasterio_io import read_raster
-    folder, ours, workers = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    folder, ours, workers, compression = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
     # the finished products of ours, read back (not timed)
     a, grid, _ = read_raster(ours, band=None)
+    if compression == "jpeg":  # 3 bands and a mask: the alpha band back from the mask
+        import rasterio
+        with rasterio.open(ours) as ds:
+            a = np.concatenate([a, ds.dataset_mask()[None]])
     idx = read_raster(ours[:-4] + "_idx.tif")[0]
     occ = read_raster(ours[:-4] + "_occ.tif")[0]
     files = sorted(glob.glob(folder + "/img_*.png"))
@@ -235,7 +244,8 @@ FLOOR = textwrap.dedent(
         with contextlib.ExitStack() as stack:  # writing the three products as ours writes them
             base = ours[:-4] + "_floor"
             w_out, w_idx, w_occ = open_products(stack, grid, base + ".tif", base + "_idx.tif",
-                                                base + "_occ.tif", a.shape[0] - 1, a.dtype)
+                                                base + "_occ.tif", a.shape[0] - 1, a.dtype, True,
+                                                compression)
             w_out.write(a)
             w_idx.write(idx)
             w_occ.write(occ)
@@ -255,6 +265,8 @@ def main() -> int:
     ap.add_argument("--focal", type=float, default=800.0)
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--tile", type=int, default=512)
+    ap.add_argument("--compress", default="deflate", choices=("deflate", "zstd", "lzw", "jpeg"),
+                    help="compression of ours' orthophoto (Orthority writes JPEG by default)")
     ap.add_argument("--no-orthority", action="store_true")
     ap.add_argument("--surface", help="another DSM of the same scene (e.g. OSGM's) instead of the truth DSM")
     ap.add_argument("--keep", action="store_true", help="keep the temporary scene and products")
@@ -300,7 +312,8 @@ def main() -> int:
             "gsd": res,
             "cells": grid.rows * grid.cols,
             "seed": args.seed,
-        }
+        },
+        "compression": args.compress,
     }
     py = sys.executable
     dsm_path = os.path.abspath(args.surface) if args.surface else os.path.join(work, "dsm.tif")
@@ -308,9 +321,9 @@ def main() -> int:
     ext = ",".join(str(v) for v in grid.extent)
     tile = str(args.tile)
     ours = run_json([py, "-P", "-c", OURS, work, os.path.join(work, "ours.tif"), str(res), tile, "1", "1",
-                     dsm_path, ext], env)
+                     dsm_path, ext, args.compress], env)
     conv = run_json([py, "-P", "-c", OURS, work, os.path.join(work, "conv.tif"), str(res), tile, "0", "0",
-                     dsm_path, ext], env)
+                     dsm_path, ext, args.compress], env)
     ours_mpx = ours["cells"] * ours["bands"] / ours["seconds"] / 1e6
     results["ours"] = {
         **ours,
@@ -347,7 +360,7 @@ def main() -> int:
         results["ours"]["sample_mpix_per_s"] = round(ours_sps, 3)
         results["ratio_sample_rate"] = round(ours_sps / results["orthority"]["valid_mpix_per_s"], 3)
         # the floor: only decoding the images and writing the three products (best of three)
-        fl = run_json([py, "-P", "-c", FLOOR, work, os.path.join(work, "ours.tif"), "2"], env)
+        fl = run_json([py, "-P", "-c", FLOOR, work, os.path.join(work, "ours.tif"), "2", args.compress], env)
         fl["mpix_per_s"] = round(fl["cells"] * fl["bands"] / fl["seconds"] / 1e6, 3)
         results["io_floor"] = fl
         o_rate = results["orthority"]["mpix_per_s"]
