@@ -12,7 +12,10 @@ release and floating-point flags are decided in one place:
   round trips hold to 1e-9.
 
 Kernels are private functions taking arrays and scalars only (no dicts, no
-I/O, no raising); public wrappers validate their inputs first.
+I/O); public wrappers validate their inputs first, so kernels do not raise on
+data. The one exception is a guard against a broken internal contract that no
+input can reach (``quickselect.select_rank``'s bounds): it raises
+``ValueError``, a programming error, rather than corrupt memory.
 """
 
 from __future__ import annotations
