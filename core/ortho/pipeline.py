@@ -129,11 +129,15 @@ class TrueOrthoConfig:
     cog : bool
         Cloud-Optimized GeoTIFF layout (with overviews) for the rasters.
     compression : {"deflate", "zstd", "lzw", "jpeg"}
-        Compression of the orthophoto. The first three are lossless (ZSTD writes fastest, DEFLATE
-        is read by every GIS). ``"jpeg"`` is lossy, for 8-bit images only and with ``cog``:
-        RGB is stored as YCbCr at ``jpeg_quality`` and the alpha band becomes the file's internal
-        mask; about a fifth of the size. The source index and the occlusion mask always stay
-        lossless (DEFLATE when ``"jpeg"``).
+        Compression of the orthophoto. The first three are lossless: DEFLATE (GDAL's level 6)
+        gives the smallest files and is read by every GIS; ZSTD (level 1) writes about twice as
+        fast and about 9 % larger; LZW for older readers. ``"jpeg"`` is lossy, for 8-bit images
+        only and with ``cog``: RGB is stored as YCbCr at ``jpeg_quality`` and the alpha band
+        becomes the file's internal mask; about a fifth of the size. YCbCr halves the colour
+        resolution, so colours blur across sharp edges: on the bench scene the ghosting measure
+        (dE > 25 within 2 cells of building outlines) reads 18 % on the JPEG file against
+        0.09 % on the lossless one. For delivery and viewing, not for measuring. The source
+        index and the occlusion mask always stay lossless (DEFLATE when ``"jpeg"``).
     jpeg_quality : int
         JPEG quality, 1-100.
     executor : {"inprocess", "local", "scheduler"}

@@ -62,7 +62,6 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     OCCLUSION = "OCCLUSION"
     SEAMLINES = "SEAMLINES"
 
-
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
             QgsProcessingParameterFile(self.ORIENTATION, tr("Orientation (TruOrtho JSON)"), extension="json")
@@ -127,7 +126,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 tr("Compression of the orthophoto"),
                 options=[
                     tr("DEFLATE (lossless, read by every GIS)"),
-                    tr("ZSTD (lossless, fastest to write)"),
+                    tr("ZSTD (lossless, fastest to write, larger)"),
                     tr("LZW (lossless)"),
                     tr("JPEG (lossy, 8-bit images only; alpha becomes a mask)"),
                 ],
