@@ -16,6 +16,7 @@ import importlib.util
 import os
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import pytest
@@ -77,6 +78,38 @@ collect_ignore: list[str] = [] if HAVE_QGIS else ["qgis"]
 
 def pytest_report_header(config):
     return f"truortho: {REPO_ROOT}; QGIS tests {'enabled' if HAVE_QGIS else 'NOT collected (no qgis.core)'}"
+
+
+def _startup_qgis_temp_dirs() -> list[Path]:
+    """The empty /tmp/QGIS3-XXXXXX folders made while this process started (pytest-qgis starts
+    QGIS before this file is imported, and QGIS 3.22 leaves that folder behind, empty, at exit)."""
+    try:
+        import psutil
+
+        start = psutil.Process().create_time() - 1.0
+    except Exception:
+        return []
+    found = []
+    for d in Path(tempfile.gettempdir()).glob("QGIS3-*"):
+        try:
+            st = d.stat()
+        except OSError:
+            continue
+        if start <= st.st_ctime <= _IMPORTED and st.st_uid == os.getuid() and not any(d.iterdir()):
+            found.append(d)
+    return found
+
+
+_IMPORTED = time.time()
+_QGIS_STARTUP_DIRS = _startup_qgis_temp_dirs()
+
+
+def pytest_unconfigure(config):
+    for d in _QGIS_STARTUP_DIRS:
+        try:
+            d.rmdir()  # only if still empty
+        except OSError:
+            pass
 
 
 def pytest_collection_modifyitems(config, items):
