@@ -152,8 +152,8 @@ class RasterWriter:
     compress : str
         ``"deflate"`` (default, GDAL's level 6), ``"lzw"``, ``"zstd"`` (level 1, the fastest),
         ``"none"`` (lossless), or ``"jpeg"``
-        (lossy, 8-bit data and ``cog`` only; 3 bands are stored as YCbCr, and an alpha band
-        becomes the file's internal mask, as GDAL's COG driver does).
+        (lossy; 8-bit RGB, optionally + alpha, and ``cog`` only: stored as YCbCr, and the alpha
+        band becomes the file's internal mask, as GDAL's COG driver does).
     quality : int
         JPEG quality (1-100) of ``compress="jpeg"``.
     block : int
@@ -201,6 +201,11 @@ class RasterWriter:
                 raise InputError(
                     f"{self.path}: JPEG compression needs 8-bit data, got {self.dtype.name}; "
                     "use a lossless compression ('deflate', 'zstd' or 'lzw')"
+                )
+            if bands - int(bool(alpha)) != 3:
+                raise InputError(
+                    f"{self.path}: JPEG compression is for 3-band (RGB) data, got "
+                    f"{bands - int(bool(alpha))} band(s); use a lossless compression"
                 )
             if not cog:
                 raise InputError(f"{self.path}: JPEG compression is written in the COG layout only")
@@ -267,8 +272,9 @@ class RasterWriter:
         if self.alpha:
             from rasterio.enums import ColorInterp
 
-            ci = [ColorInterp.red, ColorInterp.green, ColorInterp.blue][: self.bands - 1]
-            if len(ci) < self.bands - 1:
+            if self.bands - 1 == 3:
+                ci = [ColorInterp.red, ColorInterp.green, ColorInterp.blue]
+            else:  # one band (panchromatic, thermal) or a multispectral stack: grey, not red
                 ci = [ColorInterp.gray] * (self.bands - 1)
             self._ds.colorinterp = ci + [ColorInterp.alpha]
         return self

@@ -131,8 +131,8 @@ class TrueOrthoConfig:
     compression : {"deflate", "zstd", "lzw", "jpeg"}
         Compression of the orthophoto. The first three are lossless: DEFLATE (GDAL's level 6)
         gives the smallest files and is read by every GIS; ZSTD (level 1) writes about twice as
-        fast and about 9 % larger; LZW for older readers. ``"jpeg"`` is lossy, for 8-bit images
-        only and with ``cog``: RGB is stored as YCbCr at ``jpeg_quality`` and the alpha band
+        fast and about 9 % larger; LZW for older readers. ``"jpeg"`` is lossy, for 8-bit RGB
+        images only and with ``cog``: RGB is stored as YCbCr at ``jpeg_quality`` and the alpha band
         becomes the file's internal mask; about a fifth of the size. YCbCr halves the colour
         resolution, so colours blur across sharp edges: on the bench scene the ghosting measure
         (dE > 25 within 2 cells of building outlines) reads 18 % on the JPEG file against
@@ -434,10 +434,10 @@ def true_ortho(
     # only relevant images are candidates
     setup.boxes[np.setdiff1d(np.arange(len(o.images)), relevant)] = np.nan
     bands, dtype = first.bands, np.dtype(first.dtype)
-    if cfg.compression == "jpeg" and dtype != np.uint8:
+    if cfg.compression == "jpeg" and (dtype != np.uint8 or bands != 3):
         raise InputError(
-            f"compression: JPEG needs 8-bit images, but {first.path} is {dtype.name}; "
-            "use a lossless compression ('deflate', 'zstd' or 'lzw')"
+            f"compression: JPEG needs 8-bit RGB images, but {first.path} has {bands} band(s) of "
+            f"{dtype.name}; use a lossless compression ('deflate', 'zstd' or 'lzw')"
         )
     if cfg.compression == "zstd":
         from ..rasterio_io import _has_zstd

@@ -128,7 +128,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                     tr("DEFLATE (lossless, read by every GIS)"),
                     tr("ZSTD (lossless, fastest to write, larger)"),
                     tr("LZW (lossless)"),
-                    tr("JPEG (lossy, 8-bit images only; alpha becomes a mask)"),
+                    tr("JPEG (lossy, 8-bit RGB images only; alpha becomes a mask)"),
                 ],
                 defaultValue=0,
             )

@@ -263,7 +263,7 @@ HELP: dict[str, dict] = {
             "COMPRESSION": "Compression of the orthophoto. DEFLATE (the default), ZSTD and LZW are "
             "lossless: DEFLATE gives the smallest files and every GIS reads it; ZSTD (level 1) writes "
             "about twice as fast and about 9 % larger (GDAL 2.3 or later reads it); LZW is for older "
-            "readers. JPEG is lossy (about a fifth of the size), for 8-bit images only: RGB is stored as "
+            "readers. JPEG is lossy (about a fifth of the size), for 8-bit RGB images only: RGB is stored as "
             "YCbCr with halved colour resolution, so colours blur across sharp edges such as building "
             "outlines (deliver and view with it; measure on a lossless one), and the alpha band becomes "
             "the file's internal mask. The source index and occlusion mask always stay lossless.",

@@ -156,8 +156,11 @@ def test_writer_rejects_bad_compressions(tmp_path):
     g = RasterGrid(0.0, 64.0, 1.0, 64, 64, "EPSG:32632")
     with pytest.raises(InputError, match="JPEG compression needs 8-bit data, got uint16"):
         RasterWriter(tmp_path / "a.tif", g, 1, "uint16", cog=True, compress="jpeg")
+    for bands in (2, 6):  # grey + alpha (the alpha would be compressed lossy), or too many bands
+        with pytest.raises(InputError, match=f"3-band .RGB. data, got {bands - 1} band"):
+            RasterWriter(tmp_path / "a.tif", g, bands, "uint8", alpha=True, cog=True, compress="jpeg")
     with pytest.raises(InputError, match="COG layout only"):
-        RasterWriter(tmp_path / "a.tif", g, 4, "uint8", compress="jpeg")
+        RasterWriter(tmp_path / "a.tif", g, 4, "uint8", alpha=True, compress="jpeg")
     with pytest.raises(InputError, match="JPEG quality must be an integer in \\[1, 100\\], got 0"):
         RasterWriter(tmp_path / "a.tif", g, 3, "uint8", cog=True, compress="jpeg", quality=0)
     with pytest.raises(InputError, match="'webp' is not one of deflate, zstd, lzw, jpeg, none"):

@@ -310,7 +310,8 @@ def test_single_band_16_bit_and_float_keep_dtype_and_bands(data, tmp_path):
             images.append(dataclasses.replace(im, path=name))
         o2 = dataclasses.replace(o, images=images, image_root=str(root))
         ext = data["scene"].extent_world()
-        with pytest.raises(InputError, match=f"JPEG needs 8-bit images, but .*img_000.tif is {dtype}"):
+        bad_jpeg = f"JPEG needs 8-bit RGB images, but .*img_000.tif has 1 band.s. of {dtype}"
+        with pytest.raises(InputError, match=bad_jpeg):
             jpeg = TrueOrthoConfig(compression="jpeg")
             true_ortho(o2, data["folder"] / "dsm.tif", tmp_path / "j.tif", config=jpeg)
         assert not (tmp_path / "j.tif").exists()
@@ -318,6 +319,7 @@ def test_single_band_16_bit_and_float_keep_dtype_and_bands(data, tmp_path):
         r = true_ortho(o2, data["folder"] / "dsm.tif", tmp_path / f"{dtype}.tif", config=cfg)
         with rasterio.open(r.output) as ds:
             assert ds.count == 2 and ds.dtypes == (dtype, dtype)
+            assert [c.name for c in ds.colorinterp] == ["gray", "alpha"]  # not "red"
             a = ds.read()
         valid = a[1] > 0
         assert valid.mean() > 0.97
