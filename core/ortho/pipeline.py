@@ -45,6 +45,7 @@ from ..imagery import image_info
 from ..orientation import Orientation, as_orientation
 from ..parallel import Digest, InProcessExecutor, file_identity, make_executor, tile_run
 from ..progress import Progress, Steps, SubProgress, as_progress, check
+from ..rasterio_io import COMPRESSIONS
 from .color import ColorCorrection, estimate_corrections, to_channels
 from .mosaic import ImageStore, MosaicParams, candidate_colours, each
 from .seams import dissolve, region_polygons
@@ -235,8 +236,8 @@ class TrueOrthoConfig:
             bad("executor", f"expected one of {', '.join(EXECUTORS)}")
 
 
-#: compressions of the orthophoto (:attr:`TrueOrthoConfig.compression`)
-ORTHO_COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg")
+#: compressions of the orthophoto (:attr:`TrueOrthoConfig.compression`): the writer's, but "none"
+ORTHO_COMPRESSIONS = tuple(c for c in COMPRESSIONS if c != "none")
 
 
 @dataclass

@@ -53,8 +53,6 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     TILE_SIZE = "TILE_SIZE"
     COMPRESSION = "COMPRESSION"
     JPEG_QUALITY = "JPEG_QUALITY"
-    #: COMPRESSION's options, in order (TrueOrthoConfig.compression)
-    COMPRESSIONS = ("deflate", "zstd", "lzw", "jpeg")
     EXECUTOR = "EXECUTOR"
     SCHEDULER_ADDRESS = "SCHEDULER_ADDRESS"
     OUTPUT = "OUTPUT"
@@ -169,7 +167,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     @core_errors()
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 - QGIS API
         from ...core.orientation import Orientation
-        from ...core.ortho.pipeline import TrueOrthoConfig, check_output_paths, true_ortho
+        from ...core.ortho.pipeline import ORTHO_COMPRESSIONS, TrueOrthoConfig, check_output_paths, true_ortho
 
         orientation = Orientation.load(self.parameterAsFile(parameters, self.ORIENTATION, context))
         surface = self.parameterAsFile(parameters, self.SURFACE, context)
@@ -193,7 +191,8 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             max_view_angle=self.parameterAsDouble(parameters, self.MAX_VIEW_ANGLE, context),
             blend_width=self.parameterAsInt(parameters, self.BLEND_WIDTH, context),
             tile_size=self.parameterAsInt(parameters, self.TILE_SIZE, context),
-            compression=self.COMPRESSIONS[self.parameterAsEnum(parameters, self.COMPRESSION, context)],
+            # COMPRESSION's options are listed in the order of ORTHO_COMPRESSIONS
+            compression=ORTHO_COMPRESSIONS[self.parameterAsEnum(parameters, self.COMPRESSION, context)],
             jpeg_quality=self.parameterAsInt(parameters, self.JPEG_QUALITY, context),
             # true_ortho makes the executor from these and closes it at the end
             executor=executor_kind,
