@@ -52,6 +52,13 @@ class SceneConfig:
         Octaves, each twice the spacing of the previous one.
     texture_contrast : float
         Contrast stretch of the noise (higher = more saturated texture).
+    roof_contrast : (min, max)
+        Each roof's texture contrast is ``texture_contrast`` times a factor
+        drawn uniformly from this range (``(1, 1)``: all alike; near 0: a
+        nearly uniform, hard to match roof).
+    facade_windows : bool
+        A repetitive grid of dark windows on every wall (storeys of 3 m, a
+        window every 2.4 m).
 
     Ray casting
     -----------
@@ -101,6 +108,15 @@ class SceneConfig:
         Relative darkening at the image corners (0 = none).
     noise_sigma : float
         Gaussian noise in digital numbers (0-255 scale).
+    jpeg_quality : int
+        0 keeps the rendered digital numbers; 1-100 passes every image
+        through a JPEG encoder at this quality (blocking, ringing, chroma
+        subsampling), as camera JPEGs are.
+    shadow_strength : float
+        Cast shadows of the sun darken by this fraction (0 = no shadows); the
+        truth orthophoto has the same shadows (they are the scene's colour).
+    sun_azimuth_deg, sun_elevation_deg : float
+        Direction of the sun (azimuth clockwise from grid north).
 
     Ground control
     --------------
@@ -141,6 +157,8 @@ class SceneConfig:
     texture_scale: float = 0.15
     texture_octaves: int = 5
     texture_contrast: float = 2.6
+    roof_contrast: tuple[float, float] = (1.0, 1.0)
+    facade_windows: bool = False
 
     fine_step: float = 0.03
     coarse_cell: float = 2.0
@@ -165,6 +183,10 @@ class SceneConfig:
     offset_sigma: float = 0.02
     vignetting: float = 0.15
     noise_sigma: float = 1.0
+    jpeg_quality: int = 0
+    shadow_strength: float = 0.0
+    sun_azimuth_deg: float = 135.0
+    sun_elevation_deg: float = 45.0
 
     n_gcps: int = 8
     gcp_on_roof: bool = True
@@ -216,7 +238,7 @@ class SceneConfig:
                      "focal_px", "flying_height", "forward_overlap", "side_overlap", "heading_deg",
                      "attitude_sigma_deg", "position_sigma", "oblique_tilt_deg", "gain_sigma",
                      "offset_sigma", "vignetting", "noise_sigma", "check_fraction", "gcp_pixel_sigma",
-                     "gcp_clearance"):
+                     "gcp_clearance", "shadow_strength", "sun_azimuth_deg", "sun_elevation_deg"):
             finite(name, getattr(self, name))
         for name in ("terrain_relief", "building_gap", "grid_margin", "attitude_sigma_deg", "position_sigma",
                      "gain_sigma", "offset_sigma", "noise_sigma", "gcp_pixel_sigma", "gcp_clearance"):
@@ -226,6 +248,7 @@ class SceneConfig:
         pair("building_size", 2.0)
         pair("eave_height", 1.0)
         pair("roof_pitch")
+        pair("roof_contrast")
         if self.roof_pitch[1] >= 70:
             bad("roof_pitch", "must stay below 70 degrees")
         for name, lo, hi in (("texture_scale", 1e-3, 1e3), ("fine_step", 1e-3, 10.0),
@@ -233,13 +256,15 @@ class SceneConfig:
                              ("forward_overlap", 0.0, 0.95), ("side_overlap", 0.0, 0.95),
                              ("oblique_tilt_deg", 5.0, 70.0), ("vignetting", 0.0, 0.9),
                              ("check_fraction", 0.0, 1.0), ("tower_height", 1.0, 1e3),
-                             ("tower_size", 2.0, 1e3)):
+                             ("tower_size", 2.0, 1e3), ("shadow_strength", 0.0, 0.9),
+                             ("sun_elevation_deg", 5.0, 90.0)):
             if not lo <= getattr(self, name) <= hi:
                 bad(name, f"must lie in [{lo}, {hi}]")
         if self.coarse_cell < self.fine_step:
             bad("coarse_cell", "must not be smaller than fine_step")
         for name, lo, hi in (("n_buildings", 0, 100), ("texture_octaves", 1, 12), ("n_oblique", 0, 8),
                              ("supersample", 1, 6), ("n_gcps", 0, 1000), ("min_gcp_views", 1, 1000),
+                             ("jpeg_quality", 0, 100),
                              ("seed", 0, 2**31 - 1)):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, int) or not lo <= v <= hi:

@@ -48,9 +48,13 @@ class Radiometry:
     noise_seed: int
 
     def as_dict(self) -> dict:
-        return {"gain": [float(v) for v in self.gain], "offset": [float(v) for v in self.offset],
-                "vignetting": float(self.vignetting), "noise_sigma": float(self.noise_sigma),
-                "noise_seed": int(self.noise_seed)}
+        return {
+            "gain": [float(v) for v in self.gain],
+            "offset": [float(v) for v in self.offset],
+            "vignetting": float(self.vignetting),
+            "noise_sigma": float(self.noise_sigma),
+            "noise_seed": int(self.noise_seed),
+        }
 
 
 def subpixel_rays(camera: Camera, supersample: int) -> np.ndarray:
@@ -66,8 +70,9 @@ def subpixel_rays(camera: Camera, supersample: int) -> np.ndarray:
         raise InputError(f"supersample must be an integer in [1, 8], got {supersample!r}")
     off = (np.arange(s) + 0.5) / s - 0.5
     ox, oy = np.meshgrid(off, off)
-    xs, ys = np.meshgrid(np.arange(camera.width, dtype=np.float64),
-                         np.arange(camera.height, dtype=np.float64))
+    xs, ys = np.meshgrid(
+        np.arange(camera.width, dtype=np.float64), np.arange(camera.height, dtype=np.float64)
+    )
     u = xs[:, :, None] + ox.ravel()[None, None, :]
     v = ys[:, :, None] + oy.ravel()[None, None, :]
     xy = undistort_points(np.column_stack([u.ravel(), v.ravel()]), camera)
@@ -75,14 +80,15 @@ def subpixel_rays(camera: Camera, supersample: int) -> np.ndarray:
 
 
 @pjit
-def _render_centres(xy, R, C, terr, bld, g, cmax, cbld, pal, tex, sky, colour, depth, mat, bid):
+def _render_centres(xy, R, C, terr, bld, g, cmax, cbld, pal, tex, sky, sun, colour, depth, mat, bid):
     """One ray per pixel (``xy``: (H, W, 2)): colour, camera-z depth, material, building."""
     H = xy.shape[0]
     W = xy.shape[1]
     for r in prange(H):
         for c in range(W):
-            col, t, m, b, nrm = _trace(xy[r, c, 0], xy[r, c, 1], R, C, terr, bld, g, cmax, cbld, pal, tex,
-                                       sky)
+            col, t, m, b, nrm = _trace(
+                xy[r, c, 0], xy[r, c, 1], R, C, terr, bld, g, cmax, cbld, pal, tex, sky, sun
+            )
             colour[r, c, 0] = col[0]
             colour[r, c, 1] = col[1]
             colour[r, c, 2] = col[2]
@@ -92,7 +98,7 @@ def _render_centres(xy, R, C, terr, bld, g, cmax, cbld, pal, tex, sky, colour, d
 
 
 @pjit
-def _render_subpixels(xy, rows, cols, R, C, terr, bld, g, cmax, cbld, pal, tex, sky, colour):
+def _render_subpixels(xy, rows, cols, R, C, terr, bld, g, cmax, cbld, pal, tex, sky, sun, colour):
     """Mean colour of the sub-pixel rays ``xy[r, c, :]`` of the listed pixels."""
     ns = xy.shape[2]
     for n in prange(rows.shape[0]):
@@ -102,8 +108,9 @@ def _render_subpixels(xy, rows, cols, R, C, terr, bld, g, cmax, cbld, pal, tex, 
         acc1 = 0.0
         acc2 = 0.0
         for s in range(ns):
-            col, t, m, b, nrm = _trace(xy[r, c, s, 0], xy[r, c, s, 1], R, C, terr, bld, g, cmax, cbld, pal,
-                                       tex, sky)
+            col, t, m, b, nrm = _trace(
+                xy[r, c, s, 0], xy[r, c, s, 1], R, C, terr, bld, g, cmax, cbld, pal, tex, sky, sun
+            )
             acc0 += col[0]
             acc1 += col[1]
             acc2 += col[2]
@@ -113,7 +120,7 @@ def _render_subpixels(xy, rows, cols, R, C, terr, bld, g, cmax, cbld, pal, tex, 
 
 
 @njit
-def _trace(xn, yn, R, C, terr, bld, g, cmax, cbld, pal, tex, sky):
+def _trace(xn, yn, R, C, terr, bld, g, cmax, cbld, pal, tex, sky, sun):
     """Colour, distance, material, building and ``|(x', y', 1)|`` of one camera ray."""
     if not (xn == xn and yn == yn):
         return (sky[0], sky[1], sky[2]), np.nan, -1, -1, 1.0
@@ -127,7 +134,55 @@ def _trace(xn, yn, R, C, terr, bld, g, cmax, cbld, pal, tex, sky):
     t, m, b = _cast_one(C[0], C[1], C[2], dx, dy, dz, 1e6, terr, bld, g, cmax, cbld)
     if m < 0:
         return (sky[0], sky[1], sky[2]), np.nan, -1, -1, nrm
-    return _colour(C[0] + t * dx, C[1] + t * dy, C[2] + t * dz, m, b, pal, tex), t, m, b, nrm
+    x = C[0] + t * dx
+    y = C[1] + t * dy
+    z = C[2] + t * dz
+    col = _colour(x, y, z, m, b, pal, tex)
+    f = _sunlight(x, y, z, sun, terr, bld, g, cmax, cbld)
+    return (col[0] * f, col[1] * f, col[2] * f), t, m, b, nrm
+
+
+@njit
+def _sunlight(x, y, z, sun, terr, bld, g, cmax, cbld):
+    """Light factor of a surface point: ``1 - sun[3]`` in cast shadow, else 1.
+
+    ``sun = (sx, sy, sz, strength)``, ``(sx, sy, sz)`` the unit vector towards the sun; a
+    strength of 0 casts no ray. The shadow ray starts 2 cm towards the sun (a point on a roof
+    plane or wall turned away from the sun is then inside the surface: self-shadowed).
+    """
+    if sun[3] <= 0.0:
+        return 1.0
+    t, m, b = _cast_one(
+        x + 0.02 * sun[0],
+        y + 0.02 * sun[1],
+        z + 0.02 * sun[2],
+        sun[0],
+        sun[1],
+        sun[2],
+        1e6,
+        terr,
+        bld,
+        g,
+        cmax,
+        cbld,
+    )
+    return 1.0 - sun[3] if m >= 0 else 1.0
+
+
+@pjit
+def sunlight_many(pts, sun, terr, bld, g, cmax, cbld):
+    """:func:`_sunlight` of every point ``pts`` (N, 3), local frame."""
+    n = pts.shape[0]
+    out = np.empty(n)
+    for i in prange(n):
+        out[i] = _sunlight(pts[i, 0], pts[i, 1], pts[i, 2], sun, terr, bld, g, cmax, cbld)
+    return out
+
+
+def sun_vector(azimuth_deg: float, elevation_deg: float, strength: float) -> np.ndarray:
+    """``(sx, sy, sz, strength)`` of a sun at ``azimuth`` (clockwise from grid north) and ``elevation``."""
+    a, e = np.radians(azimuth_deg), np.radians(elevation_deg)
+    return np.array([np.sin(a) * np.cos(e), np.cos(a) * np.cos(e), np.sin(e), float(strength)])
 
 
 def edge_pixels(depth: np.ndarray, material: np.ndarray, building: np.ndarray, rel_depth: float = 0.01):
@@ -148,8 +203,17 @@ def edge_pixels(depth: np.ndarray, material: np.ndarray, building: np.ndarray, r
     return edge
 
 
-def render_colour(surface: Surface, palette: np.ndarray, tex: np.ndarray, R, C, centre_rays: np.ndarray,
-                  sub_rays: np.ndarray | None = None, adaptive: bool = True):
+def render_colour(
+    surface: Surface,
+    palette: np.ndarray,
+    tex: np.ndarray,
+    R,
+    C,
+    centre_rays: np.ndarray,
+    sub_rays: np.ndarray | None = None,
+    adaptive: bool = True,
+    sun: np.ndarray | None = None,
+):
     """Noise-free colour of one image plus per-pixel labels.
 
     Parameters
@@ -163,6 +227,8 @@ def render_colour(surface: Surface, palette: np.ndarray, tex: np.ndarray, R, C, 
         Supersample only the pixels at material, building or depth edges
         (:func:`edge_pixels`) and keep the centre sample elsewhere; False
         supersamples every pixel.
+    sun : (4,), optional
+        :func:`sun_vector`: cast shadows (default none).
 
     Returns
     -------
@@ -177,7 +243,18 @@ def render_colour(surface: Surface, palette: np.ndarray, tex: np.ndarray, R, C, 
         raise InputError("render_colour: expected R (3, 3) and centre rays (H, W, 1, 2)")
     H, W = centre_rays.shape[:2]
     sky = np.asarray(SKY_RGB, dtype=np.float64)
-    arrays = (surface.terr, surface.bld, surface.grid, surface.cell_max, surface.cell_bld, palette, tex, sky)
+    sunv = np.zeros(4) if sun is None else np.ascontiguousarray(np.asarray(sun, dtype=np.float64).reshape(4))
+    arrays = (
+        surface.terr,
+        surface.bld,
+        surface.grid,
+        surface.cell_max,
+        surface.cell_bld,
+        palette,
+        tex,
+        sky,
+        sunv,
+    )
     colour = np.empty((H, W, 3), np.float32)
     depth = np.empty((H, W))
     mat = np.empty((H, W), np.int8)
@@ -196,8 +273,11 @@ def apply_radiometry(colour: np.ndarray, camera: Camera, radiometry: Radiometry)
     """Digital numbers (H, W, 3) uint8 of a noise-free colour image (see module docstring)."""
     H, W = colour.shape[:2]
     xs, ys = np.meshgrid(np.arange(W) - camera.cx, np.arange(H) - camera.cy)
-    corner = max(np.hypot(cx, cy) for cx in (-0.5 - camera.cx, W - 0.5 - camera.cx)
-                 for cy in (-0.5 - camera.cy, H - 0.5 - camera.cy))
+    corner = max(
+        np.hypot(cx, cy)
+        for cx in (-0.5 - camera.cx, W - 0.5 - camera.cx)
+        for cy in (-0.5 - camera.cy, H - 0.5 - camera.cy)
+    )
     vig = 1.0 - radiometry.vignetting * (np.hypot(xs, ys) / corner) ** 2
     val = (colour.astype(np.float64) * radiometry.gain + radiometry.offset) * vig[:, :, None] * 255.0
     if radiometry.noise_sigma > 0:
@@ -206,8 +286,28 @@ def apply_radiometry(colour: np.ndarray, camera: Camera, radiometry: Radiometry)
     return np.clip(np.round(val), 0, 255).astype(np.uint8)
 
 
-def random_radiometry(rng: np.random.Generator, gain_sigma: float, offset_sigma: float, vignetting: float,
-                      noise_sigma: float, noise_seed: int) -> Radiometry:
+def jpeg_roundtrip(image: np.ndarray, quality: int) -> np.ndarray:
+    """``image`` (H, W, 3) uint8 RGB encoded as a JPEG at ``quality`` and decoded (0: unchanged)."""
+    if not quality:
+        return image
+    import cv2
+
+    ok, buf = cv2.imencode(
+        ".jpg", np.ascontiguousarray(image[:, :, ::-1]), [cv2.IMWRITE_JPEG_QUALITY, int(quality)]
+    )
+    if not ok:
+        raise InputError("jpeg_roundtrip: the JPEG encoder failed")
+    return np.ascontiguousarray(cv2.imdecode(buf, cv2.IMREAD_COLOR)[:, :, ::-1])
+
+
+def random_radiometry(
+    rng: np.random.Generator,
+    gain_sigma: float,
+    offset_sigma: float,
+    vignetting: float,
+    noise_sigma: float,
+    noise_seed: int,
+) -> Radiometry:
     """Per-image exposure drawn from ``rng`` (gain: common factor plus a third of it per channel)."""
     common = rng.normal(0.0, gain_sigma)
     gain = 1.0 + common + rng.normal(0.0, gain_sigma / 3.0, 3)

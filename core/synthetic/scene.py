@@ -27,7 +27,15 @@ from . import truth
 from .cameras import make_camera, nadir_block, oblique_cameras
 from .config import SceneConfig
 from .raycast import cast_rays
-from .render import Radiometry, apply_radiometry, random_radiometry, render_colour, subpixel_rays
+from .render import (
+    Radiometry,
+    apply_radiometry,
+    jpeg_roundtrip,
+    random_radiometry,
+    render_colour,
+    subpixel_rays,
+    sun_vector,
+)
 from .surface import Surface
 from .texture import _colour_many, palette, texture_params
 
@@ -73,6 +81,7 @@ class SyntheticScene:
     render_seconds: float
     palette: np.ndarray = field(repr=False, default_factory=lambda: np.zeros((2, 3)))
     tex: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(4))
+    sun: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(4))
     _rays: dict = field(repr=False, default_factory=dict)
 
     # ---------------------------------------------------------- access
@@ -136,7 +145,7 @@ class SyntheticScene:
         exposure differences (roof or ground, never walls).
         """
         rgb, gt = truth.orthophoto(self.surface, self.palette, self.tex, resolution,
-                                   extent or self.extent_world(), self.offset)
+                                   extent or self.extent_world(), self.offset, self.sun)
         return (np.clip(np.round(rgb * 255), 0, 255).astype(np.uint8) if as_uint8 else rgb), gt
 
     def visibility(self, points_world, image: int | str, tol: float = 0.01, check_frame: bool = True):
@@ -179,10 +188,12 @@ class SyntheticScene:
         ad = self.config.adaptive_supersampling if adaptive is None else bool(adaptive)
         t0 = time.perf_counter()
         colour, depth, mat, bid = render_colour(self.surface, self.palette, self.tex, im.R, im.C,
-                                                self._subpixel(1), self._subpixel(s) if s > 1 else None, ad)
+                                                self._subpixel(1), self._subpixel(s) if s > 1 else None, ad,
+                                                self.sun)
         if radiometry:
             idx = self.orientation.images.index(im)
-            return apply_radiometry(colour, self.camera, self.radiometry[idx])
+            return jpeg_roundtrip(apply_radiometry(colour, self.camera, self.radiometry[idx]),
+                                  self.config.jpeg_quality)
         return RenderResult(colour, depth, mat, bid, time.perf_counter() - t0)
 
     def depth_map(self, image: int | str) -> np.ndarray:
@@ -290,21 +301,23 @@ def make_scene(config: SceneConfig | None = None, progress: Progress | None = No
     meta = {"synthetic": {"seed": cfg.seed, "n_nadir": n_nadir, "n_oblique": len(images) - n_nadir}}
     frame = LocalFrame(cfg.crs, np.asarray(cfg.offset, dtype=np.float64))
     orientation = Orientation(frame, {cam.id: cam}, images, None, [], ".", meta)
-    scene = SyntheticScene(cfg, surface, orientation, [], [], n_nadir, 0.0,
-                           palette(len(surface.buildings)), texture_params(cfg.seed, cfg.texture_scale,
-                                                                           cfg.texture_octaves,
-                                                                           cfg.texture_contrast))
+    nb = len(surface.buildings)
+    roof_contrast = np.random.default_rng([cfg.seed, 43]).uniform(*cfg.roof_contrast, nb)
+    tex = texture_params(cfg.seed, cfg.texture_scale, cfg.texture_octaves, cfg.texture_contrast,
+                         cfg.facade_windows, roof_contrast)
+    sun = sun_vector(cfg.sun_azimuth_deg, cfg.sun_elevation_deg, cfg.shadow_strength)
+    scene = SyntheticScene(cfg, surface, orientation, [], [], n_nadir, 0.0, palette(nb), tex, sun)
     rng = np.random.default_rng([cfg.seed, 41])
     t0 = time.perf_counter()
     sub = scene._subpixel(cfg.supersample) if cfg.supersample > 1 else None
     for k, im in enumerate(images):
         check(progress)
         colour, _, _, _ = render_colour(surface, scene.palette, scene.tex, im.R, im.C, scene._subpixel(1),
-                                        sub, cfg.adaptive_supersampling)
+                                        sub, cfg.adaptive_supersampling, sun)
         rad = random_radiometry(rng, cfg.gain_sigma, cfg.offset_sigma, cfg.vignetting, cfg.noise_sigma,
                                 cfg.seed * 1000 + k)
         scene.radiometry.append(rad)
-        scene.images.append(apply_radiometry(colour, cam, rad))
+        scene.images.append(jpeg_roundtrip(apply_radiometry(colour, cam, rad), cfg.jpeg_quality))
         progress.update(0.95 * (k + 1) / len(images), f"rendered {im.name}")
     scene.render_seconds = time.perf_counter() - t0
     orientation.gcps = truth.select_gcps(surface, images, cam, cfg.offset, cfg.n_gcps, cfg.gcp_on_roof,

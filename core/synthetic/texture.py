@@ -6,7 +6,9 @@ lattice spacings ``texture_scale * 2**k``, ``k = 0 .. octaves-1`` (about 1 to
 20 GSD with the defaults), so the texture is matchable at every scale. Ground
 mixes two base colours with a slow noise; every roof and every building's
 walls have their own base colour, chosen so that ground, roof and wall colours
-are far apart (CIE76 ΔE*ab well above 25 between the bases).
+are far apart (CIE76 ΔE*ab well above 25 between the bases). Optional, for harder scenes
+(:func:`texture_params`): a lower texture contrast on chosen roofs (nearly uniform roofs), and
+a repetitive grid of dark windows on the walls.
 
 Colours are floats in [0, 1] (display RGB, no gamma handling: they *are* the
 pixel values divided by 255).
@@ -56,9 +58,16 @@ def palette(n_buildings: int) -> np.ndarray:
     return pal
 
 
-def texture_params(seed: int, scale: float, octaves: int, contrast: float) -> np.ndarray:
-    """Packed texture parameters for the kernels: ``[seed, scale, octaves, contrast]``."""
-    return np.array([float(seed), float(scale), float(octaves), float(contrast)])
+def texture_params(seed: int, scale: float, octaves: int, contrast: float, windows: bool = False,
+                   roof_contrast=()) -> np.ndarray:
+    """Packed texture parameters for the kernels.
+
+    ``[seed, scale, octaves, contrast, windows, c_0, ..., c_{n-1}]``: ``windows`` (0/1) puts a
+    repetitive grid of dark windows on every wall; ``c_b`` scales the texture contrast of the
+    roof of building ``b`` (1 when absent: a contrast near 0 is a nearly uniform roof).
+    """
+    rc = [float(v) for v in roof_contrast]
+    return np.array([float(seed), float(scale), float(octaves), float(contrast), float(bool(windows))] + rc)
 
 
 # ---------------------------------------------------------------- kernels
@@ -126,9 +135,19 @@ def _colour(x, y, z, mat, b, pal, tex):
     """RGB in [0, 1] of the surface point (x, y, z) of material ``mat`` (building ``b``)."""
     seed = np.int64(tex[0])
     n = _fbm(x, y, z, seed + 37 * mat, tex[1], np.int64(tex[2]))
-    v = 0.5 + tex[3] * (n - 0.5)
+    contrast = tex[3]
+    if mat == 1 and tex.shape[0] > 5 + b:
+        contrast *= tex[5 + b]
+    v = 0.5 + contrast * (n - 0.5)
     v = min(max(v, 0.0), 1.0)
     shade = 0.45 + 0.9 * v
+    if mat == 2 and tex.shape[0] > 4 and tex[4] > 0.5:
+        # storeys of 3 m and a window every 2.4 m along the wall (x + y runs along any wall
+        # not at 135 degrees); windows are dark and nearly uniform: a repetitive facade
+        fz = z / 3.0 - np.floor(z / 3.0)
+        fs = (x + y) / 2.4 - np.floor((x + y) / 2.4)
+        if 0.35 < fz < 0.8 and 0.3 < fs < 0.75:
+            shade = 0.25 + 0.1 * v
     if mat == 0:
         m = _value_noise(x / 9.0, y / 9.0, z / 9.0, seed + 5)
         m = min(max(2.0 * m - 0.5, 0.0), 1.0)

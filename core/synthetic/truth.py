@@ -54,18 +54,23 @@ def dsm(surface: Surface, resolution: float, extent_world, offset):
     return (h + offset[2]).reshape(shape).astype(np.float32), gt
 
 
-def orthophoto(surface: Surface, palette, tex, resolution: float, extent_world, offset):
+def orthophoto(surface: Surface, palette, tex, resolution: float, extent_world, offset, sun=None):
     """True colour seen vertically from above at cell centres.
 
     Returns ``(float32 (rows, cols, 3) in [0, 1], geotransform)``: roofs
     and ground only (walls are never seen from straight above), no exposure
-    differences.
+    differences; cast shadows of ``sun`` (:func:`~.render.sun_vector`) as in the images.
     """
     xy, shape, gt = grid_centres(resolution, extent_world, offset)
     h, bid = surface.height(xy)
     mat = np.where(bid >= 0, ROOF, GROUND).astype(np.int64)
     pts = np.ascontiguousarray(np.column_stack([xy, h]))
     rgb = _colour_many(pts, mat, np.ascontiguousarray(bid), palette, tex)
+    if sun is not None and sun[3] > 0:
+        from .render import sunlight_many
+
+        rgb *= sunlight_many(pts, np.asarray(sun, dtype=np.float64), surface.terr, surface.bld, surface.grid,
+                             surface.cell_max, surface.cell_bld)[:, None]
     return rgb.reshape(shape + (3,)).astype(np.float32), gt
 
 

@@ -19,14 +19,25 @@ from truortho.core.synthetic.texture import GROUND_RGB, ROOF_RGB, WALL_RGB
 def scene():
     t0 = time.perf_counter()
     s = make_scene(SceneConfig(seed=1))
-    print(f"\nsynthetic scene: {len(s.images)} images {s.camera.width}x{s.camera.height}, "
-          f"render {s.render_seconds:.2f} s, total {time.perf_counter() - t0:.2f} s (incl. JIT on first use)")
+    print(
+        f"\nsynthetic scene: {len(s.images)} images {s.camera.width}x{s.camera.height}, "
+        f"render {s.render_seconds:.2f} s, total {time.perf_counter() - t0:.2f} s (incl. JIT on first use)"
+    )
     return s
 
 
 def _small(seed=5, **kw):
-    return SceneConfig(seed=seed, image_size=(160, 120), focal_px=200.0, n_buildings=3, n_oblique=1,
-                       n_gcps=4, min_gcp_views=2, grid_margin=150.0, **kw)
+    return SceneConfig(
+        seed=seed,
+        image_size=(160, 120),
+        focal_px=200.0,
+        n_buildings=3,
+        n_oblique=1,
+        n_gcps=4,
+        min_gcp_views=2,
+        grid_margin=150.0,
+        **kw,
+    )
 
 
 def test_determinism():
@@ -52,7 +63,7 @@ def test_block_layout(scene):
     assert all(im.R[2, 2] < -0.99 for im in nadir)  # looking down
     # kappa flips between strips: image x axes of the first and the last image are opposite
     assert nadir[0].R[0] @ nadir[-1].R[0] < -0.95
-    for im in o.images[scene.n_nadir:]:
+    for im in o.images[scene.n_nadir :]:
         tilt = math.degrees(math.acos(-im.R[2, 2]))
         assert 35 <= tilt <= 45
 
@@ -145,8 +156,12 @@ def test_occlusion_behind_tower(scene):
 def _roof_height(b, xy):
     u, v = b.to_uv(xy)[0]
     a, w = b.half_size
-    prof = {"flat": 0.0, "gable": 1 - abs(v) / w, "hip": min(1 - abs(v) / w, (a - abs(u)) / w),
-            "shed": (v + w) / (2 * w)}[b.roof]
+    prof = {
+        "flat": 0.0,
+        "gable": 1 - abs(v) / w,
+        "hip": min(1 - abs(v) / w, (a - abs(u)) / w),
+        "shed": (v + w) / (2 * w),
+    }[b.roof]
     return b.eave_top + b.ridge * prof
 
 
@@ -247,3 +262,63 @@ def test_invalid_config():
         SceneConfig(forward_overlap=1.2)
     with pytest.raises(InputError, match="could not place"):
         make_scene(SceneConfig(extent=(0.0, 0.0, 30.0, 30.0), n_buildings=20))
+
+
+def test_harder_appearance_options():
+    """Shadows (images and truth alike), JPEG artefacts, low-contrast roofs and facade windows."""
+    plain = make_scene(_small(noise_sigma=0.0, vignetting=0.0, gain_sigma=0.0, offset_sigma=0.0))
+    hard = make_scene(
+        _small(
+            noise_sigma=0.0,
+            vignetting=0.0,
+            gain_sigma=0.0,
+            offset_sigma=0.0,
+            jpeg_quality=60,
+            shadow_strength=0.5,
+            sun_elevation_deg=30.0,
+            roof_contrast=(0.0, 0.0),
+            facade_windows=True,
+        )
+    )
+    assert plain.orientation.to_dict() == hard.orientation.to_dict()
+    # truth orthophoto: shadowed cells are exactly half as bright, lit cells unchanged
+    a, _ = plain.orthophoto(0.5, as_uint8=False)
+    b, _ = hard.orthophoto(0.5, as_uint8=False)
+    ratio = b.sum(-1) / np.maximum(a.sum(-1), 1e-9)
+    lit = np.isclose(ratio, 1.0, atol=1e-6)
+    dark = np.isclose(ratio, 0.5, atol=1e-6)
+    assert 0.05 < dark.mean() < 0.6 and (lit | dark).mean() > 0.7
+    X, Y = np.meshgrid(np.arange(a.shape[1]), np.arange(a.shape[0]))
+    _, bid = hard.surface.height(np.column_stack([
+        hard.extent_world()[0] - hard.offset[0] + (X.ravel() + 0.5) * 0.5,
+        hard.extent_world()[3] - hard.offset[1] - (Y.ravel() + 0.5) * 0.5]))  # fmt: skip
+    roofs = (bid >= 0).reshape(a.shape[:2])
+    # ground: only lit or shadowed; roofs also lose their texture (contrast 0) and are uniform
+    assert roofs.any() and (lit | dark)[~roofs].all()
+    for b_id in np.unique(bid[bid >= 0]):
+        cells = (bid.reshape(a.shape[:2]) == b_id) & lit
+        if cells.sum() > 4:
+            assert b[cells].std(axis=0).max() < 1e-6  # a uniform roof (no texture)
+    # images: JPEG changes the digital numbers a little, not the content
+    rendered = hard.render(0, radiometry=True)
+    assert np.array_equal(rendered, hard.images[0])
+    noise_free = hard.render(0)
+    ref = np.round(noise_free.colour * 255)
+    diff = np.abs(hard.images[0].astype(float) - ref)
+    assert 0.2 < diff.mean() < 15.0  # quality 60 on a fine texture
+    assert np.corrcoef(hard.images[0].ravel(), ref.ravel())[0, 1] > 0.9
+    # windows: wall pixels of the hard scene hold many very dark pixels, the plain scene's none
+    wall = noise_free.material == WALL
+    if wall.sum() > 50:
+        assert (noise_free.colour[wall].max(-1) < 0.2).mean() > 0.05
+
+
+def test_sun_vector_points_to_the_sun():
+    from truortho.core.synthetic.render import sun_vector
+
+    s = sun_vector(90.0, 30.0, 0.4)  # east, 30 degrees up
+    assert np.allclose(s, [math.cos(math.radians(30)), 0.0, 0.5, 0.4], atol=1e-12)
+    with pytest.raises(InputError, match="jpeg_quality"):
+        _small(jpeg_quality=101)
+    with pytest.raises(InputError, match="shadow_strength"):
+        _small(shadow_strength=1.5)
