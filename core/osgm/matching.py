@@ -23,7 +23,7 @@ never computed.
    coarser level's surface, median over the views), :func:`~truortho.core.sgm.select`
    (winner-take-all, parabola, uniqueness, confidence), minima on the border
    of a cell's own window rejected (the surface lies outside it), and a
-   NaN-aware median.
+   NaN-aware median as an outlier test (:func:`median_outliers`).
 """
 
 from __future__ import annotations
@@ -200,6 +200,27 @@ def sample_surface(images: list[TileImage], x0, y0, res, z: np.ndarray) -> np.nd
     return np.stack(out) if out else np.full((0, rows, cols), np.nan, np.float32)
 
 
+#: A cell departing from the median of its neighbourhood by more than this many Z levels is an outlier.
+MEDIAN_TOLERANCE = 1.0
+
+
+def median_outliers(level: np.ndarray, size: int, tolerance: float = MEDIAN_TOLERANCE) -> np.ndarray:
+    """The median filter of the selected levels, used as an outlier test only.
+
+    A cell whose window (``size x size``) holds fewer than half valid cells
+    becomes NaN, and a cell more than ``tolerance`` levels away from the
+    NaN-aware median of its window takes the median (a spike or a pit); every
+    other cell keeps its own sub-level value. Replacing *every* cell by the
+    median would throw the sub-level refinement away: on a slope the median
+    of a window is, most of the time, a value copied from the cells beside
+    the centre along the contour line, so runs of equal heights form along
+    the contours and the DSM gets streaks parallel to them.
+    """
+    med = median_filter(level, size, min_count=max(1, (size * size) // 2))
+    keep = np.isfinite(med) & (np.abs(level - med) <= tolerance)
+    return np.where(keep, level, med).astype(np.float32)
+
+
 def _median_view(samples: np.ndarray) -> np.ndarray:
     """Median over the views (NaN where none sees the cell)."""
     with warnings.catch_warnings():
@@ -286,7 +307,7 @@ def match_tile(
     level[edge] = np.nan
     conf[edge] = np.nan
     if params.median > 1:
-        level = median_filter(level, params.median, min_count=max(1, (params.median**2) // 2))
+        level = median_outliers(level, params.median)
         conf[~np.isfinite(level)] = np.nan
     z = (z_base + level.astype(np.float64) * dz).astype(np.float32)
     return TileResult(z, conf.astype(np.float32), images, evaluated, nd)

@@ -381,26 +381,81 @@ def default_resolution(o: Orientation, z_local: float) -> float:
     return float(np.median(g))
 
 
-def default_extent(o: Orientation, z_local: float) -> tuple[float, float, float, float]:
-    """World extent: the sparse points (1-99 %), else the union of the near-nadir footprints."""
+#: Cells across the longer side of the raster on which :func:`default_extent` counts the footprints.
+EXTENT_CELLS = 256
+
+
+def _inside_polygon(px: np.ndarray, py: np.ndarray, poly: np.ndarray) -> np.ndarray:
+    """Even-odd test of the points ``(px, py)`` (same shapes) against the polygon ``poly`` (M, 2)."""
+    inside = np.zeros(px.shape, bool)
+    x, y = poly[:, 0], poly[:, 1]
+    xn, yn = np.roll(x, -1), np.roll(y, -1)
+    for x0, y0, x1, y1 in zip(x, y, xn, yn, strict=True):
+        if y0 == y1:
+            continue
+        cross = (y0 > py) != (y1 > py)
+        xi = x0 + (py - y0) * (x1 - x0) / (y1 - y0)
+        inside ^= cross & (px < xi)
+    return inside
+
+
+def default_extent(
+    o: Orientation, z_local: float, max_view_angle: float | None = None, min_views: int = 2
+) -> tuple[float, float, float, float]:
+    """World extent: the area seen by at least ``min_views`` near-nadir images, and the sparse points.
+
+    The footprints of the near-nadir images on the plane ``Z = z_local`` are
+    counted on a raster of :data:`EXTENT_CELLS` cells across (a cell counts for
+    an image when it lies in its footprint and, with ``max_view_angle``, its
+    ray to the camera is at most that far from the vertical, as in the
+    matching); the extent is the bounding box of the cells seen by at least
+    ``min_views`` of them (every one, when no cell is), united with the 1-99 %
+    box of the sparse points (terrain above or below ``z_local`` is seen a
+    little elsewhere). The sparse points alone would leave out the parts of the
+    block where few tie points were kept, often a large share of the area the
+    photos see.
+    """
     from ..geometry.footprint import footprint_on_plane
 
     off = o.offset
-    if o.points is not None and len(o.points) >= 20:
-        lo = np.percentile(o.points.xyz[:, :2], 1, axis=0)
-        hi = np.percentile(o.points.xyz[:, :2], 99, axis=0)
-    else:
-        pts = []
-        for i in _nadir(o):
-            im = o.images[i]
-            fp = footprint_on_plane(im.R, im.C, o.camera_of(im), z_local)
-            if fp is not None:
-                pts.append(fp)
-        if not pts:
-            raise InputError("EXTENT: no image sees the ground; give an extent")
-        allp = np.vstack(pts)
+    feet = []
+    for i in _nadir(o):
+        im = o.images[i]
+        fp = footprint_on_plane(im.R, im.C, o.camera_of(im), z_local)
+        if fp is not None and np.isfinite(fp).all():
+            feet.append((fp, np.asarray(im.C, np.float64)))
+    boxes = []
+    if feet:
+        allp = np.vstack([f for f, _ in feet])
         lo, hi = allp.min(axis=0), allp.max(axis=0)
-    return (float(lo[0] + off[0]), float(lo[1] + off[1]), float(hi[0] + off[0]), float(hi[1] + off[1]))
+        step = max(float(np.max(hi - lo)) / EXTENT_CELLS, 1e-9)
+        xs = lo[0] + (np.arange(int(np.ceil((hi[0] - lo[0]) / step)) + 1)) * step
+        ys = lo[1] + (np.arange(int(np.ceil((hi[1] - lo[1]) / step)) + 1)) * step
+        X, Y = np.meshgrid(xs, ys)
+        count = np.zeros(X.shape, np.int32)
+        tan_max = math.tan(math.radians(max_view_angle)) if max_view_angle is not None else None
+        for fp, C in feet:
+            seen = _inside_polygon(X, Y, fp)
+            if tan_max is not None:
+                height = C[2] - float(z_local)
+                seen &= np.hypot(X - C[0], Y - C[1]) <= tan_max * max(height, 0.0)
+            count += seen
+        need = min(int(min_views), len(feet))
+        ok = count >= need
+        if not ok.any():
+            ok = count >= 1
+        if ok.any():
+            boxes.append((X[ok].min() - step, Y[ok].min() - step, X[ok].max() + step, Y[ok].max() + step))
+    if o.points is not None and len(o.points) >= 20:
+        plo = np.percentile(o.points.xyz[:, :2], 1, axis=0)
+        phi = np.percentile(o.points.xyz[:, :2], 99, axis=0)
+        boxes.append((plo[0], plo[1], phi[0], phi[1]))
+    if not boxes:
+        raise InputError("EXTENT: no image sees the ground; give an extent")
+    b = np.array(boxes, np.float64)
+    x0, y0 = b[:, 0].min(), b[:, 1].min()
+    x1, y1 = b[:, 2].max(), b[:, 3].max()
+    return (float(x0 + off[0]), float(y0 + off[1]), float(x1 + off[0]), float(y1 + off[1]))
 
 
 # ------------------------------------------------------------------ one system
@@ -631,8 +686,8 @@ def run_osgm(
     orientation : Orientation or path of an orientation JSON
     config : OsgmConfig
     extent : (xmin, ymin, xmax, ymax), optional
-        World coordinates in the orientation's CRS; default the sparse points'
-        extent or the union of the near-nadir footprints.
+        World coordinates in the orientation's CRS; default the area seen by at
+        least two near-nadir images, and the sparse points (:func:`default_extent`).
     outputs : OsgmOutputs
         DSM (float32 GeoTIFF, nodata -9999), CONFIDENCE (float32 in [0, 1]),
         ORTHOIMAGE (uint8 RGB, 0 = no data), POINT_CLOUD (LAS/LAZ with RGB,
@@ -680,7 +735,7 @@ def run_osgm(
     res = float(cfg.resolution) if cfg.resolution else default_resolution(o, ground)
     dz = float(cfg.z_step) if cfg.z_step else res
     if extent is None:
-        extent = default_extent(o, ground)
+        extent = default_extent(o, ground, cfg.max_view_angle)
     grid = RasterGrid.from_extent(extent, res, o.crs)
     _check_overlap(o, grid, ground)
     off = o.offset
@@ -810,7 +865,7 @@ def _check_overlap(o: Orientation, grid: RasterGrid, ground: float) -> None:
     """The extent must meet the area the images see (clear error instead of an empty DSM)."""
     x0, y0, x1, y1 = grid.extent
     try:
-        bx0, by0, bx1, by1 = default_extent(o, ground)
+        bx0, by0, bx1, by1 = default_extent(o, ground, min_views=1)
     except InputError:
         return
     if x1 < bx0 or x0 > bx1 or y1 < by0 or y0 > by1:
