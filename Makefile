@@ -9,7 +9,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source scripts/env.sh &&
 
-.PHONY: setup test lint pytest demo bench zip
+.PHONY: setup test lint pytest demo bench acceptance zip
 
 setup:
 	bash scripts/setup.sh
@@ -35,6 +35,12 @@ BENCH ?= *
 bench: setup
 	$(ENV) $(PY) -m pip install -q -r requirements-bench.txt -c constraints.txt
 	@for f in bench/bench_$(BENCH).py; do echo "== $$f"; $(ENV) $(PY) -P $$f || exit 1; done
+
+# Randomized acceptance battery (not a test; about an hour on 2 cores): DSM and true ortho on 12
+# synthetic cities drawn from wide ranges, against their truth and a pairwise OpenCV SGBM baseline.
+# make acceptance ACCEPTANCE_ARGS="--only 3,7 --no-sgbm"; --write-docs updates docs/acceptance.md.
+acceptance: setup
+	$(ENV) $(PY) -P bench/acceptance.py $(ACCEPTANCE_ARGS)
 
 # The installable plugin zip (truortho/ at its root; no tests, benchmarks or data beyond the demo sample).
 zip: setup

@@ -64,7 +64,7 @@ class LevelPlan:
         """
         if lv == 0:
             return params
-        return dataclasses.replace(params, p2=max(params.p1 + 1, int(round(params.p2 / 2**lv))))
+        return dataclasses.replace(params, p2=max(params.p1 + 1, int(round(params.p2 / 2**lv))), edges=False)
 
 
 def plan_levels(z_min: float, z_max: float, dz: float, grid: RasterGrid, max_levels: int = 5) -> LevelPlan:

@@ -71,6 +71,7 @@ class TileParams:
     max_images: int
     max_view_angle: float
     median: int
+    edges: bool = False  # refine the sides of height steps (:mod:`.edges`; the finest level only)
 
 
 def _lattice(x0, y0, res, rows, cols, n=9):
@@ -310,4 +311,8 @@ def match_tile(
         level = median_outliers(level, params.median)
         conf[~np.isfinite(level)] = np.nan
     z = (z_base + level.astype(np.float64) * dz).astype(np.float32)
+    if params.edges:
+        from .edges import refine_edges
+
+        z = refine_edges(z, images, x0, y0, res, max(1.0, 4.0 * dz), 2.0 * dz)
     return TileResult(z, conf.astype(np.float32), images, evaluated, nd)

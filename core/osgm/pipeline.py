@@ -100,6 +100,10 @@ class OsgmConfig:
     uniqueness : float
     median : int
         Median filter size (odd; 1 = off).
+    refine_edges : bool
+        Re-decide the side of every cell near a height step on the finest
+        level with occlusion-aware 3 x 3 photo-consistency (:mod:`.edges`):
+        against the fattening of window matching at building outlines.
     band : int, optional
         0-based band to match on; default the luminance.
     max_levels : int
@@ -144,6 +148,7 @@ class OsgmConfig:
     measure: str = "gradient"
     uniqueness: float = 0.99
     median: int = 3
+    refine_edges: bool = True
     band: int | None = None
     max_levels: int = 5
     cache_bytes: int = 1 << 30
@@ -207,6 +212,7 @@ class OsgmConfig:
             max_images=int(self.max_images),
             max_view_angle=float(self.max_view_angle),
             median=int(self.median),
+            edges=bool(self.refine_edges),
         )
 
 

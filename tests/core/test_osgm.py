@@ -388,3 +388,34 @@ def test_image_windows_from_tiled_tiff_match_the_decoded_image(small_scene, tmp_
         tol = 1e-6 if level == 0 else 0.02  # GDAL's average vs OpenCV's area halvings
         assert np.abs(a[ok] - b[ok]).mean() < tol, level
     assert windowed.reads == 3  # one windowed read per request, never the whole image
+
+
+def test_edge_refinement_undoes_fattening(tmp_path):
+    """Occlusion-aware side decision at height steps (core/osgm/edges.py): less ground at roof height."""
+    from scipy.ndimage import maximum_filter, minimum_filter
+
+    scene = make_scene(
+        _small_config(
+            extent=(-25.0, -20.0, 25.0, 20.0),
+            n_buildings=3,
+            eave_height=(6.0, 9.0),
+            image_size=(320, 240),
+            focal_px=400.0,
+        )
+    )
+    scene.write(tmp_path)
+    res = scene.config.gsd
+    shares = {}
+    for refine in (False, True):
+        out = OsgmOutputs(dsm=tmp_path / f"dsm_{refine}.tif")
+        cfg = OsgmConfig(resolution=res, refine_edges=refine)
+        run_osgm(scene.orientation, cfg, scene.extent_world(), out, tmp_path)
+        dsm, grid, _ = read_raster(out.dsm)
+        truth, nvis = _truth_and_seen(scene, grid)
+        low = (maximum_filter(truth, 7) - truth > 2.0) & (nvis >= 2)  # ground within 3 cells of a wall
+        high = (truth - minimum_filter(truth, 7) > 2.0) & (nvis >= 2)
+        e = np.nan_to_num(dsm - truth, nan=0.0)
+        shares[refine] = ((low & (e > 2.0)).mean() / low.mean(), (high & (e < -2.0)).mean() / high.mean())
+    print(f"\nfattened / eroded share near walls: without {shares[False]}, with refinement {shares[True]}")
+    assert shares[True][0] < 0.8 * shares[False][0]
+    assert shares[True][1] < shares[False][1] + 0.05

@@ -1,0 +1,531 @@
+"""Randomized acceptance battery: DSM (OSGM) and true orthophoto on scenes nobody tuned for.
+
+Not a test (``make test`` never runs it). Run from the repository root::
+
+    make acceptance                               # 12 scenes, master seed 2026
+    source scripts/env.sh && python -P bench/acceptance.py [--scenes 12] [--seed 2026] [--only 3,7]
+        [--no-sgbm] [--keep DIR] [--write-docs]
+
+Every scene is a :mod:`truortho.core.synthetic` city drawn from wide ranges by
+``default_rng([seed, index])`` (:func:`draw_config`): building density, heights up to 60 m,
+flat/gable/hip/shed roofs, narrow streets and courtyards, low-texture roofs, repetitive facades,
+sun shadows, nadir-only and nadir + oblique blocks (4-8 obliques, tilts 30-45 degrees), overlaps
+60/30 to 80/60, exposure and white-balance jitter, vignetting, noise, JPEG compression, lens
+distortion. Odd scenes have obliques, even ones are nadir only, so that both kinds are always in
+the battery. The given (true) cameras are used: this measures dense matching and the true ortho,
+not the orientation.
+
+Per scene, against the exact truth on the truth DSM's grid (the scene extent at the nominal GSD):
+
+* **OSGM** (:func:`truortho.core.osgm.run_osgm`, defaults, only ``Z_MIN``/``Z_MAX`` from the truth
+  range widened by 5 m, as a user who knows the site would give), over the cells whose truth point
+  is seen by at least two images: completeness, NMAD (GSD), the share of non-edge cells within
+  3 GSD and of edge cells (within 2 GSD of a height step over 2 m) within 3 GSD (holes count as
+  misses); wall seconds and seconds per million (cells x images);
+* the **pairwise OpenCV SGBM baseline** (``bench/sgbm_baseline.py``: rectified pairs, SGBM 3WAY,
+  triangulation, median fusion onto the same grid), the same figures and its wall seconds;
+* the **true ortho** (:func:`truortho.core.ortho.pipeline.true_ortho`, defaults) on the truth DSM
+  and on the OSGM DSM, and the conventional ortho (``visibility=False``) on the truth DSM:
+  ghosting, median shift, coverage and mean dE (``core/ortho/evaluate.py``), and the share of
+  cells seen by no image (truth, eroded by one cell) that carry a colour ("wrong fill").
+
+Also, not goals: the mean dE after the best global per-channel gain and offset to the truth
+(``relative_dE``: the block's absolute exposure is not observable, see :func:`relative_delta_e`), and
+the streak index of the DSMs (:func:`truortho.core.surface.quality.streak_index`). One picture per
+scene goes to ``bench/results/acceptance/scene_NN.jpg`` (hillshades of the truth and OSGM DSMs,
+true orthos on both).
+
+Then the distribution over the scenes (median, worst, share meeting the goal of issue 17) and
+the OSGM / SGBM time ratio. Results go to ``bench/results/acceptance.json``; ``--write-docs``
+replaces the marked section of ``docs/acceptance.md`` with the table, the command, the commit
+and the machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+DOCS = os.path.join(ROOT, "docs", "acceptance.md")
+
+#: (figure, comparison, goal): the goals of issue 17, applied to every scene
+GOALS = (
+    ("osgm.completeness", ">=", 0.98),
+    ("osgm.nmad_gsd", "<=", 0.5),
+    ("osgm.flat3", ">=", 0.97),
+    ("osgm.edge3", ">=", 0.80),
+    ("ortho_truth.ghosting", "<=", 0.01),
+    ("ortho_truth.ghosting_vs_conventional", "<=", 0.10),
+    ("ortho_osgm.ghosting", "<=", 0.02),
+    ("ortho_truth.shift_gsd", "<=", 0.3),
+    ("ortho_osgm.shift_gsd", "<=", 0.3),
+    ("ortho_truth.mean_dE", "<=", 3.0),
+    ("ortho_truth.wrong_fill", "<=", 0.0),
+)
+
+
+# ------------------------------------------------------------------ scenes
+
+
+def draw_config(index: int, seed: int):
+    """The :class:`~truortho.core.synthetic.SceneConfig` of scene ``index`` (deterministic)."""
+    from truortho.core.synthetic import SceneConfig
+
+    rng = np.random.default_rng([seed, index])
+    u = rng.uniform
+    oblique = index % 2 == 1
+    side = u(60.0, 100.0)
+    aspect = u(0.75, 1.0)
+    area = side * side * aspect
+    density = u(1.2, 4.8)  # buildings per 1,000 m^2 (as many as fit: the generator keeps the gaps)
+    size_lo = u(5.0, 10.0)
+    size_hi = size_lo + u(4.0, 14.0)
+    tall = u(8.0, 25.0)
+    flying = u(110.0, 170.0)
+    gsd = u(0.10, 0.18)
+    width = int(rng.choice([480, 560, 640]))
+    cfg = SceneConfig(
+        extent=(-side / 2, -side * aspect / 2, side / 2, side * aspect / 2),
+        terrain_relief=u(0.0, 8.0),
+        n_buildings=int(max(2, round(density * area / 1000.0))),
+        building_size=(size_lo, size_hi),
+        eave_height=(u(3.0, 6.0), tall),
+        roof_pitch=(u(15.0, 30.0), u(30.0, 50.0)),
+        building_gap=u(1.5, 7.0),
+        tower=bool(rng.random() < 0.7),
+        tower_height=u(20.0, 60.0),
+        tower_size=u(7.0, 14.0),
+        texture_scale=gsd * u(1.0, 2.0),
+        texture_contrast=u(1.2, 3.0),
+        roof_contrast=(u(0.05, 0.4), 1.0),
+        facade_windows=bool(rng.random() < 0.6),
+        image_size=(width, width * 3 // 4),
+        focal_px=flying / gsd,
+        principal_offset=(u(-4, 4), u(-4, 4)),
+        distortion=(u(-0.15, 0.05), u(-0.02, 0.05), u(-5e-4, 5e-4), u(-5e-4, 5e-4), 0.0),
+        flying_height=flying,
+        forward_overlap=u(0.6, 0.8),
+        side_overlap=u(0.3, 0.6),
+        heading_deg=u(0.0, 360.0),
+        n_oblique=int(rng.integers(4, 9)) if oblique else 0,
+        oblique_tilt_deg=u(30.0, 45.0),
+        gain_sigma=u(0.04, 0.15),
+        offset_sigma=u(0.0, 0.03),
+        vignetting=u(0.0, 0.3),
+        noise_sigma=u(0.5, 3.0),
+        jpeg_quality=int(rng.integers(70, 96)),
+        shadow_strength=u(0.0, 0.6),
+        sun_azimuth_deg=u(0.0, 360.0),
+        sun_elevation_deg=u(25.0, 70.0),
+        seed=int(rng.integers(0, 2**31 - 1)),
+    )
+    return _fit(cfg)
+
+
+def _fit(cfg):
+    """``cfg`` with as many of its buildings as the generator can place with their gaps."""
+    import dataclasses
+
+    from truortho.core.errors import InputError
+    from truortho.core.synthetic.surface import Surface
+
+    while True:
+        try:
+            Surface(cfg)
+            return cfg
+        except InputError as exc:
+            if "could not place" not in str(exc) or cfg.n_buildings <= 2:
+                raise
+            cfg = dataclasses.replace(cfg, n_buildings=max(2, int(cfg.n_buildings * 0.85)))
+
+
+def describe(cfg) -> str:
+    w, h = cfg.image_size
+    return (
+        f"{cfg.extent[2] - cfg.extent[0]:.0f}x{cfg.extent[3] - cfg.extent[1]:.0f} m, {cfg.n_buildings} bldg"
+        f"{' + tower ' + format(cfg.tower_height, '.0f') + ' m' if cfg.tower else ''}, eaves to "
+        f"{cfg.eave_height[1]:.0f} m, gap {cfg.building_gap:.1f} m, GSD {cfg.gsd:.3f} m, {w}x{h} px, overlap "
+        f"{100 * cfg.forward_overlap:.0f}/{100 * cfg.side_overlap:.0f}, obliques {cfg.n_oblique}"
+        f"{' at ' + format(cfg.oblique_tilt_deg, '.0f') + ' deg' if cfg.n_oblique else ''}, JPEG q"
+        f"{cfg.jpeg_quality}, shadows {cfg.shadow_strength:.2f}, "
+        f"windows {'yes' if cfg.facade_windows else 'no'}"
+    )
+
+
+# ------------------------------------------------------------------ figures
+
+
+def _maxf(a, n):
+    from scipy.ndimage import maximum_filter
+
+    return maximum_filter(a, size=n, mode="nearest")
+
+
+def _minf(a, n):
+    from scipy.ndimage import minimum_filter
+
+    return minimum_filter(a, size=n, mode="nearest")
+
+
+def dsm_masks(truth: np.ndarray, gsd: float, res: float) -> np.ndarray:
+    """Cells within 2 GSD of a height step over 2 m of the truth (the 'edge' cells)."""
+    step = (_maxf(truth, 3) - _minf(truth, 3)) > 2.0
+    r = max(1, int(math.ceil(2.0 * gsd / res)))
+    return _maxf(step.astype(np.uint8), 2 * r + 1).astype(bool)
+
+
+def dsm_figures(dsm: np.ndarray, truth: np.ndarray, seen2: np.ndarray, edge: np.ndarray, gsd: float) -> dict:
+    """Completeness, NMAD (GSD) and shares within 3 GSD over the cells seen by >= 2 images."""
+    e = dsm - truth
+    ok = np.isfinite(e) & seen2
+    if not ok.any():
+        return {"completeness": 0.0, "nmad_gsd": float("nan"), "flat3": 0.0, "edge3": 0.0}
+    nmad = 1.4826 * float(np.median(np.abs(e[ok] - np.median(e[ok]))))
+    good = np.abs(np.nan_to_num(e, nan=1e9)) <= 3 * gsd
+    return {
+        "completeness": float(ok.sum() / seen2.sum()),
+        "nmad_gsd": nmad / gsd,
+        "flat3": float(good[seen2 & ~edge].mean()),
+        "edge3": float(good[seen2 & edge].mean()) if (seen2 & edge).any() else 1.0,
+    }
+
+
+def relative_delta_e(rgb: np.ndarray, truth_rgb: np.ndarray, valid: np.ndarray) -> float:
+    """Mean dE after the best global per-channel gain and offset from the result to the truth.
+
+    A block's absolute exposure is not observable from its images (the colour correction fixes
+    the block's mean gain at 1, the images' true mean gain is not 1), so mean dE mixes that
+    constant offset with what a user sees: seams, colour casts between images, wrong sources.
+    """
+    from truortho.core.ortho import evaluate as ev
+
+    a = rgb[valid].astype(np.float64)
+    b = truth_rgb[valid].astype(np.float64)
+    fitted = np.empty_like(a)
+    for ch in range(3):
+        A = np.column_stack([a[:, ch], np.ones(len(a))])
+        coef, *_ = np.linalg.lstsq(A, b[:, ch], rcond=None)
+        fitted[:, ch] = A @ coef
+    fitted = np.clip(np.round(fitted), 0, 255).astype(np.uint8)
+    return float(ev.delta_e(fitted[None], truth_rgb[valid][None]).mean()) if len(a) else float("nan")
+
+
+def ortho_figures(path: str, truth_rgb, buildings, seen, unseen_core, gsd: float, res: float) -> dict:
+    import rasterio
+
+    from truortho.core.ortho import evaluate as ev
+
+    with rasterio.open(path) as ds:
+        rgb = np.moveaxis(ds.read([1, 2, 3]), 0, -1)
+        valid = ds.dataset_mask() > 0
+    gh = ev.ghosting(rgb, truth_rgb, valid, buildings, 2.0 * gsd / res)
+    sh = ev.phase_shift(rgb.astype(float).mean(-1) / 255, truth_rgb.astype(float).mean(-1) / 255, valid)
+    n_unseen = int(unseen_core.sum())
+    return {
+        "ghosting": gh["share"],
+        "shift_gsd": sh["median"] * res / gsd,
+        "coverage": ev.coverage(valid, seen),
+        "mean_dE": ev.mean_delta_e(rgb, truth_rgb, valid & seen),
+        "relative_dE": relative_delta_e(rgb, truth_rgb, valid & seen),
+        "wrong_fill": float((valid & unseen_core).sum() / n_unseen) if n_unseen else 0.0,
+        "unseen_cells": n_unseen,
+    }
+
+
+def seen_counts(scene, grid, truth: np.ndarray, max_view_angle: float = 90.0) -> np.ndarray:
+    """Images that see each cell's truth point (within ``max_view_angle`` off nadir)."""
+    X, Y = grid.centres()
+    P = np.column_stack([X.ravel(), Y.ravel(), truth.ravel()])
+    n = np.zeros(len(P), np.int32)
+    cosmax = math.cos(math.radians(max_view_angle))
+    for i, im in enumerate(scene.orientation.images):
+        d = im.C + scene.offset - P
+        cz = d[:, 2] / np.linalg.norm(d, axis=1)
+        todo = cz >= cosmax
+        if todo.any():
+            vis, _, _ = scene.visibility(P[todo], i, tol=0.05)
+            n[np.flatnonzero(todo)[vis]] += 1
+    return n.reshape(grid.shape)
+
+
+# ------------------------------------------------------------------ one scene
+
+
+def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
+    from scipy.ndimage import binary_erosion
+
+    from truortho.core.ortho import evaluate as ev
+    from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho
+    from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
+    from truortho.core.rasterio_io import read_raster
+    from truortho.core.surface.quality import streak_index
+    from truortho.core.synthetic import make_scene
+
+    cfg = draw_config(index, seed)
+    log(f"scene {index}: {describe(cfg)}")
+    t = time.perf_counter()
+    scene = make_scene(cfg)
+    folder = os.path.join(work, f"scene_{index:02d}")
+    scene.write(folder)
+    gsd = cfg.gsd
+    truth, grid, _ = read_raster(os.path.join(folder, "dsm.tif"))
+    res = grid.res
+    truth_rgb, _ = scene.orthophoto(res)
+    n_images = len(scene.orientation.images)
+    log(f"  rendered {n_images} images in {time.perf_counter() - t:.1f} s; grid {grid.rows}x{grid.cols}")
+
+    nvis = seen_counts(scene, grid, truth)
+    seen2 = nvis >= 2
+    edge = dsm_masks(truth, gsd, res)
+    buildings = ev.building_mask(scene, grid)
+    ortho_angle = TrueOrthoConfig().max_view_angle
+    seen_ortho = seen_counts(scene, grid, truth, ortho_angle) >= 1
+    unseen_core = binary_erosion(~seen_ortho, iterations=1)
+    row: dict = {
+        "scene": index,
+        "config": describe(cfg),
+        "images": n_images,
+        "obliques": cfg.n_oblique,
+        "cells": grid.rows * grid.cols,
+        "gsd": gsd,
+        "seen2": float(seen2.mean()),
+    }
+
+    zlo, zhi = float(np.nanmin(truth)) - 5.0, float(np.nanmax(truth)) + 5.0
+    out = OsgmOutputs(dsm=os.path.join(folder, "osgm.tif"))
+    t = time.perf_counter()
+    run_osgm(scene.orientation, OsgmConfig(resolution=res, z_min=zlo, z_max=zhi), scene.extent_world(), out,
+             folder)  # fmt: skip
+    t_osgm = time.perf_counter() - t
+    dsm, _, _ = read_raster(out.dsm)
+    row["osgm"] = dsm_figures(dsm, truth, seen2, edge, gsd)
+    row["osgm"]["streak_index"] = streak_index(dsm)
+    row["truth_streak_index"] = streak_index(truth)
+    row["osgm"]["seconds"] = t_osgm
+    row["osgm"]["s_per_mcell_image"] = t_osgm / (grid.rows * grid.cols * n_images / 1e6)
+    log(f"  OSGM {t_osgm:.1f} s: {_fmt(row['osgm'])}")
+
+    if sgbm:
+        sys.path.insert(0, HERE)
+        from sgbm_baseline import sgbm_dsm
+
+        t = time.perf_counter()
+        base, info = sgbm_dsm(scene.orientation, folder, grid, zlo, zhi)
+        t_sgbm = time.perf_counter() - t
+        row["sgbm"] = dsm_figures(base, truth, seen2, edge, gsd)
+        row["sgbm"]["streak_index"] = streak_index(base)
+        row["sgbm"].update(seconds=t_sgbm, pairs=info.get("pairs"))
+        row["osgm_over_sgbm_time"] = t_osgm / t_sgbm
+        log(f"  SGBM {t_sgbm:.1f} s: {_fmt(row['sgbm'])}")
+
+    for key, surface, vis in (("ortho_truth", "dsm.tif", True), ("ortho_conventional", "dsm.tif", False),
+                              ("ortho_osgm", "osgm.tif", True)):  # fmt: skip
+        path = os.path.join(folder, f"{key}.tif")
+        t = time.perf_counter()
+        occ = os.path.join(folder, f"{key}_occ.tif")
+        ocfg = TrueOrthoConfig(resolution=res, visibility=vis, extent=scene.extent_world())
+        true_ortho(
+            scene.orientation, os.path.join(folder, surface), path, None, occ, config=ocfg, image_root=folder
+        )
+        row[key] = ortho_figures(path, truth_rgb, buildings, seen_ortho, unseen_core, gsd, res)
+        row[key]["seconds"] = time.perf_counter() - t
+        log(f"  {key}: {_fmt(row[key])}")
+    pictures(folder, os.path.join(HERE, "results", "acceptance", f"scene_{index:02d}.jpg"))
+    conv = row["ortho_conventional"]["ghosting"]
+    row["ortho_truth"]["ghosting_vs_conventional"] = row["ortho_truth"]["ghosting"] / conv if conv else 0.0
+    row["passed"] = [name for name, _, _ in GOALS if meets(row, name)]
+    row["failed"] = [name for name, _, _ in GOALS if not meets(row, name)]
+    log(f"  goals failed: {', '.join(row['failed']) or 'none'}")
+    return row
+
+
+def pictures(folder: str, path: str) -> None:
+    """One JPEG per scene: hillshades of the truth and OSGM DSMs over the true orthos on them."""
+    import cv2
+    import rasterio
+
+    def hillshade(name: str) -> np.ndarray:
+        with rasterio.open(os.path.join(folder, name)) as ds:
+            z = ds.read(1, masked=True).filled(np.nan).astype(np.float64)
+            res = ds.res[0]
+        gy, gx = np.gradient(np.where(np.isfinite(z), z, np.nanmin(z)), res)
+        slope, aspect = np.arctan(np.hypot(gx, gy)), np.arctan2(-gx, gy)
+        alt, az = np.radians(45.0), np.radians(315.0)
+        h = np.sin(alt) * np.cos(slope) + np.cos(alt) * np.sin(slope) * np.cos(az - aspect)
+        img = cv2.cvtColor((np.clip(h, 0, 1) * 255).astype(np.uint8), cv2.COLOR_GRAY2BGR)
+        img[~np.isfinite(z)] = (0, 0, 255)  # holes red
+        return img
+
+    def ortho(name: str) -> np.ndarray:
+        with rasterio.open(os.path.join(folder, name)) as ds:
+            a = np.moveaxis(ds.read([1, 2, 3]), 0, -1)[:, :, ::-1].copy()
+            a[ds.dataset_mask() == 0] = (255, 0, 255)  # no data magenta
+        return a
+
+    tiles = [hillshade("dsm.tif"), hillshade("osgm.tif"), ortho("ortho_truth.tif"), ortho("ortho_osgm.tif")]
+    h = min(t.shape[0] for t in tiles)
+    w = min(t.shape[1] for t in tiles)
+    out = np.vstack(
+        [np.hstack([tiles[0][:h, :w], tiles[1][:h, :w]]), np.hstack([tiles[2][:h, :w], tiles[3][:h, :w]])]
+    )
+    scale = min(1.0, 1200.0 / out.shape[1])
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    cv2.imwrite(path, cv2.resize(out, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA),
+                [cv2.IMWRITE_JPEG_QUALITY, 85])  # fmt: skip
+
+
+def _fmt(d: dict) -> str:
+    return ", ".join(f"{k} {v:.4g}" if isinstance(v, float) else f"{k} {v}" for k, v in d.items())
+
+
+def value(row: dict, name: str) -> float:
+    part, key = name.split(".")
+    return float(row.get(part, {}).get(key, float("nan")))
+
+
+def meets(row: dict, name: str) -> bool:
+    cmp, goal = next((c, g) for n, c, g in GOALS if n == name)
+    v = value(row, name)
+    if not math.isfinite(v):
+        return False
+    return v >= goal if cmp == ">=" else v <= goal + 1e-12
+
+
+# ------------------------------------------------------------------ report
+
+
+def summary(rows: list[dict]) -> list[str]:
+    lines = ["| figure | goal | median | worst | scenes meeting the goal |", "|---|---|---|---|---|"]
+    for name, cmp, goal in GOALS:
+        vals = np.array([value(r, name) for r in rows])
+        worst = np.nanmin(vals) if cmp == ">=" else np.nanmax(vals)
+        ok = sum(meets(r, name) for r in rows)
+        lines.append(
+            f"| {name} | {cmp} {goal:g} | {np.nanmedian(vals):.4g} | {worst:.4g} | {ok} / {len(rows)} |"
+        )
+    if all("sgbm" in r for r in rows):
+        for name in ("completeness", "nmad_gsd", "flat3", "edge3", "seconds"):
+            o = np.array([r["osgm"][name] for r in rows])
+            s = np.array([r["sgbm"][name] for r in rows])
+            lines.append(
+                f"| SGBM baseline {name} (OSGM median) | | {np.nanmedian(s):.4g} ({np.nanmedian(o):.4g}) | "
+                f"{np.nanmax(s) if name in ('nmad_gsd', 'seconds') else np.nanmin(s):.4g} | |"
+            )
+        ratio = np.array([r["osgm_over_sgbm_time"] for r in rows])
+        lines.append(
+            f"| OSGM time / SGBM time | <= 1 | {np.median(ratio):.3g} | {ratio.max():.3g} | "
+            f"{int((ratio <= 1).sum())} / {len(rows)} |"
+        )
+    for name in ("ortho_truth.relative_dE", "ortho_osgm.mean_dE", "ortho_osgm.relative_dE",
+                 "ortho_conventional.ghosting", "osgm.streak_index", "truth_streak_index"):  # fmt: skip
+        vals = np.array([value(r, name) if "." in name else r[name] for r in rows])
+        lines.append(f"| {name} (not a goal) | | {np.nanmedian(vals):.4g} | {np.nanmax(vals):.4g} | |")
+    spm = np.array([r["osgm"]["s_per_mcell_image"] for r in rows])
+    lines.append(f"| OSGM s per million (cells x images) | | {np.median(spm):.3g} | {spm.max():.3g} | |")
+    allok = sum(not r["failed"] for r in rows)
+    lines.append(f"| **every goal** | | | | **{allok} / {len(rows)}** |")
+    return lines
+
+
+def scene_table(rows: list[dict]) -> list[str]:
+    head = (
+        "| # | imgs (obl) | OSGM compl | NMAD | flat3 | edge3 | s | SGBM compl | NMAD | flat3 | edge3 | s | "
+        "ghost truth | conv | ghost OSGM | shift | dE | wrong fill | failed |"
+    )
+    lines = [head, "|" + "---|" * (head.count("|") - 1)]
+    for r in rows:
+        o, s = r["osgm"], r.get("sgbm")
+        t, c, g = r["ortho_truth"], r["ortho_conventional"], r["ortho_osgm"]
+        sg = (
+            (
+                f"{100 * s['completeness']:.1f} | {s['nmad_gsd']:.2f} | {100 * s['flat3']:.1f} | "
+                f"{100 * s['edge3']:.1f} | {s['seconds']:.0f}"
+            )
+            if s
+            else "- | - | - | - | -"
+        )
+        lines.append(
+            f"| {r['scene']} | {r['images']} ({r['obliques']}) | {100 * o['completeness']:.1f} | "
+            f"{o['nmad_gsd']:.2f} | "
+            f"{100 * o['flat3']:.1f} | {100 * o['edge3']:.1f} | {o['seconds']:.0f} | {sg} | "
+            f"{100 * t['ghosting']:.2f} | {100 * c['ghosting']:.1f} | {100 * g['ghosting']:.2f} | "
+            f"{t['shift_gsd']:.2f} | {t['mean_dE']:.2f} | {100 * t['wrong_fill']:.2f} | "
+            f"{', '.join(r['failed']) or '-'} |"
+        )
+    return lines
+
+
+def write_docs(text: str) -> None:
+    begin, end = "<!-- acceptance:begin -->", "<!-- acceptance:end -->"
+    doc = (
+        open(DOCS, encoding="utf-8").read()
+        if os.path.exists(DOCS)
+        else f"# Acceptance battery\n\n{begin}\n{end}\n"
+    )
+    if begin not in doc or end not in doc:
+        raise SystemExit(f"{DOCS}: the markers {begin} / {end} are missing")
+    new = doc[: doc.index(begin) + len(begin)] + "\n" + text + "\n" + doc[doc.index(end) :]
+    tmp = DOCS + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as fh:
+        fh.write(new)
+    os.replace(tmp, DOCS)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--scenes", type=int, default=12)
+    ap.add_argument("--seed", type=int, default=2026)
+    ap.add_argument("--only", default="", help="comma-separated scene indices (default all)")
+    ap.add_argument("--no-sgbm", action="store_true", help="skip the pairwise SGBM baseline")
+    ap.add_argument("--keep", default="", help="keep the scenes and products in this folder")
+    ap.add_argument("--write-docs", action="store_true", help=f"update the marked section of {DOCS}")
+    args = ap.parse_args(argv)
+    indices = [int(v) for v in args.only.split(",") if v] or list(range(args.scenes))
+    work = args.keep or tempfile.mkdtemp(prefix="truortho-acceptance-")
+    os.makedirs(work, exist_ok=True)
+
+    def log(msg: str) -> None:
+        print(msg, flush=True)
+
+    t0 = time.perf_counter()
+    rows = []
+    try:
+        for i in indices:
+            rows.append(run_scene(i, args.seed, work, not args.no_sgbm, log))
+    finally:
+        if not args.keep:
+            shutil.rmtree(work, ignore_errors=True)
+    wall = time.perf_counter() - t0
+    cmd = "python -P bench/acceptance.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()  # fmt: skip
+    import cv2
+
+    head = (f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {platform.machine()} "
+            f"{os.cpu_count()} cores, OpenCV {cv2.__version__}; {len(rows)} scenes, master seed {args.seed}, "
+            f"{wall / 60:.1f} min")  # fmt: skip
+    text = "\n".join([head, "", *summary(rows), "", *scene_table(rows), ""])
+    print("\n" + text)
+    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
+    with open(os.path.join(HERE, "results", "acceptance.json"), "w") as fh:
+        json.dump({"command": cmd, "commit": commit, "seed": args.seed, "rows": rows}, fh, indent=1)
+    if args.write_docs:
+        write_docs(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
