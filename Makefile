@@ -9,7 +9,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source scripts/env.sh &&
 
-.PHONY: setup test lint pytest demo bench acceptance zip
+.PHONY: setup test lint pytest demo bench acceptance acceptance-real zip
 
 setup:
 	bash scripts/setup.sh
@@ -41,6 +41,10 @@ bench: setup
 # make acceptance ACCEPTANCE_ARGS="--only 3,7 --no-sgbm"; --write-docs updates docs/acceptance.md.
 acceptance: setup
 	$(ENV) $(PY) -P bench/acceptance.py $(ACCEPTANCE_ARGS)
+
+# Real photo blocks through the whole pipeline (no truth DSM): make acceptance-real REAL_ARGS="--blocks sample,brighton"
+acceptance-real: setup
+	$(ENV) $(PY) -P bench/real_blocks.py $(REAL_ARGS)
 
 # The installable plugin zip (truortho/ at its root; no tests, benchmarks or data beyond the demo sample).
 zip: setup

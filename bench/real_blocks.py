@@ -1,0 +1,245 @@
+"""Real photo blocks through the whole pipeline, measured without a truth DSM (issue 17, part 4).
+
+Not a test. Run from the repository root::
+
+    make acceptance-real                      # the bundled sample (make demo's block)
+    source scripts/env.sh && python -P bench/real_blocks.py --blocks sample,brighton,boruszyn,copr \
+        [--resolution 0] [--keep DIR] [--write-docs]
+
+Each block runs as a user would run it: ``truortho:importgcps`` (where the block has an ODM
+``gcp_list.txt``), then ``truortho:pipeline`` through ``qgis_process`` with its defaults (the
+check points named below stay out of the adjustment). On the products (:func:`measures`):
+
+* **completeness**: the share of valid cells of the filtered DSM among the cells that at least two
+  near-nadir photos see (footprints on the median ground height, within 45 degrees off nadir);
+* **holes**: the share of those cells without a height in the raw OSGM DSM, and the holes of at
+  least 1 m^2 counted;
+* **roughness**: the median RMS residual of a plane fitted to 2 m x 2 m windows of the filtered DSM
+  whose slope is under 10 degrees (flat ground: noise, streaks and pits raise it);
+* **streak index** of the filtered DSM (:func:`truortho.core.surface.quality.streak_index`): near 1
+  on natural terrain;
+* **empty share** of the true ortho's frame (the cells with no colour) and its isolated empty
+  cells (no colour, all 8 neighbours coloured: speckle), and the cells flagged in OCCLUSION;
+* the wall time of the pipeline, and a picture per block (hillshade beside the ortho) in
+  ``bench/results/real/``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+DATA = os.path.join(os.path.dirname(ROOT), "shared", "data")
+DOCS = os.path.join(ROOT, "docs", "acceptance.md")
+QP = os.path.join(ROOT, "scripts", "qgis_process")
+
+#: name: (image folder, gcp_list.txt or None, check points)
+SAMPLE = os.path.join(ROOT, "sample", "copr")
+BLOCKS = {
+    "sample": (os.path.join(SAMPLE, "images"), os.path.join(SAMPLE, "gcp_list.txt"), "gcp06,gcp08"),
+    "copr": (os.path.join(DATA, "copr", "images"), os.path.join(DATA, "copr", "gcp_list.txt"), "gcp06,gcp08"),
+    "boruszyn": (
+        os.path.join(DATA, "boruszyn", "images"),
+        os.path.join(DATA, "boruszyn", "gcp_list.txt"),
+        "",
+    ),
+    "brighton": (os.path.join(DATA, "brighton", "images"), None, ""),
+}
+
+
+def run_block(name: str, out: str, resolution: float, log) -> dict:
+    images, gcps, checks = BLOCKS[name]
+    if not os.path.isdir(images):
+        raise SystemExit(f"{name}: image folder {images} not found")
+    os.makedirs(out, exist_ok=True)
+    args = [f"IMAGES={images}", f"RESOLUTION={resolution}", f"OUTPUT_FOLDER={os.path.join(out, 'products')}"]
+    if gcps:
+        imp = [QP, "run", "truortho:importgcps", "--", f"INPUT={gcps}", f"GCPS={out}/gcps.gpkg",
+               f"OBSERVATIONS={out}/obs.gpkg"] + ([f"CHECK_POINTS={checks}"] if checks else [])  # fmt: skip
+        subprocess.run(imp, check=True, capture_output=True)
+        args += [f"GCPS={out}/gcps.gpkg", f"OBSERVATIONS={out}/obs.gpkg"]
+    log(f"{name}: truortho:pipeline on {len(os.listdir(images))} photos")
+    t = time.perf_counter()
+    p = subprocess.run([QP, "run", "truortho:pipeline", "--", *args], capture_output=True, text=True)
+    seconds = time.perf_counter() - t
+    with open(os.path.join(out, "pipeline.log"), "w") as fh:
+        fh.write(p.stdout + p.stderr)
+    if p.returncode:
+        raise SystemExit(f"{name}: the pipeline failed (see {out}/pipeline.log):\n{p.stderr[-2000:]}")
+    m = measures(os.path.join(out, "products"))
+    m.update(block=name, seconds=seconds)
+    picture(os.path.join(out, "products"), os.path.join(HERE, "results", "real", f"{name}.jpg"))
+    log(f"  {json.dumps(m)}")
+    return m
+
+
+def footprint_count(orientation, grid, z_world: float, max_view_angle: float = 45.0) -> np.ndarray:
+    """Near-nadir photos whose frame holds each cell centre at height ``z_world``."""
+    from truortho.core.geometry import project_points
+
+    X, Y = grid.centres()
+    off = orientation.offset
+    P = np.column_stack([X.ravel() - off[0], Y.ravel() - off[1], np.full(X.size, z_world - off[2])])
+    count = np.zeros(X.size, np.int32)
+    tan_max = math.tan(math.radians(max_view_angle))
+    for im in orientation.images:
+        if im.R[2, 2] > -math.cos(math.radians(30.0)):  # not near nadir
+            continue
+        cam = orientation.camera_of(im)
+        near = np.hypot(P[:, 0] - im.C[0], P[:, 1] - im.C[1]) <= tan_max * max(im.C[2] - P[0, 2], 0.0)
+        uv = project_points(P[near], im.R, im.C, cam)
+        inside = (
+            (uv[:, 0] >= -0.5)
+            & (uv[:, 0] <= cam.width - 0.5)
+            & (uv[:, 1] >= -0.5)
+            & (uv[:, 1] <= cam.height - 0.5)
+        )
+        idx = np.flatnonzero(near)[inside]
+        count[idx] += 1
+    return count.reshape(grid.shape)
+
+
+def roughness(z: np.ndarray, res: float, window_m: float = 2.0, max_slope_deg: float = 10.0) -> float:
+    """Median RMS residual (m) of planes fitted to ``window_m`` windows sloping under ``max_slope_deg``."""
+    n = max(3, int(round(window_m / res)))
+    yy, xx = np.mgrid[0:n, 0:n]
+    A = np.column_stack([xx.ravel() * res, yy.ravel() * res, np.ones(n * n)])
+    out = []
+    for r0 in range(0, z.shape[0] - n + 1, n):
+        for c0 in range(0, z.shape[1] - n + 1, n):
+            w = z[r0 : r0 + n, c0 : c0 + n].ravel()
+            if not np.isfinite(w).all():
+                continue
+            coef, *_ = np.linalg.lstsq(A, w, rcond=None)
+            if math.degrees(math.atan(math.hypot(coef[0], coef[1]))) > max_slope_deg:
+                continue
+            out.append(float(np.sqrt(np.mean((w - A @ coef) ** 2))))
+    return float(np.median(out)) if out else float("nan")
+
+
+def measures(products: str) -> dict:
+    import rasterio
+    from scipy.ndimage import convolve, label
+
+    from truortho.core.orientation import as_orientation
+    from truortho.core.rasterio_io import read_raster
+    from truortho.core.surface.quality import streak_index
+
+    o = as_orientation(os.path.join(products, "orientation.json"))
+    dsm, grid, _ = read_raster(os.path.join(products, "dsm.tif"))
+    raw, _, _ = read_raster(os.path.join(products, "dsm_raw.tif"))
+    ground = float(np.nanmedian(dsm))
+    seen2 = footprint_count(o, grid, ground) >= 2
+    with rasterio.open(os.path.join(products, "trueortho.tif")) as ds:
+        valid = ds.dataset_mask() > 0
+    with rasterio.open(os.path.join(products, "occlusion.tif")) as ds:
+        occ = ds.read(1)
+    _, ogrid, _ = read_raster(os.path.join(products, "occlusion.tif"))
+    oseen2 = seen2 if ogrid.shape == grid.shape else footprint_count(o, ogrid, ground) >= 2
+    empty = ~valid
+    neighbours = convolve(valid.astype(np.int32), np.ones((3, 3), np.int32), mode="constant") - valid
+    holes, n_holes = label(seen2 & ~np.isfinite(raw))
+    big = int((np.bincount(holes.ravel())[1:] * grid.res**2 >= 1.0).sum()) if n_holes else 0
+    return {
+        "cells": int(grid.rows * grid.cols),
+        "resolution": grid.res,
+        "area_seen2_m2": float(seen2.sum() * grid.res**2),
+        "completeness": float(np.isfinite(dsm)[seen2].mean()) if seen2.any() else 0.0,
+        "raw_holes": float((~np.isfinite(raw))[seen2].mean()) if seen2.any() else 0.0,
+        "holes_over_1m2": big,
+        "roughness_m": roughness(dsm, grid.res),
+        "streak_index": streak_index(dsm),
+        "ortho_empty": float(empty.mean()),
+        "ortho_empty_seen2": float(empty[oseen2].mean()) if oseen2.any() else 0.0,
+        "ortho_speckle": int((empty & (neighbours == 8)).sum()),
+        "occlusion_flagged": int((occ == 1).sum()),
+    }
+
+
+def picture(products: str, path: str) -> None:
+    import cv2
+    import rasterio
+
+    with rasterio.open(os.path.join(products, "dsm.tif")) as ds:
+        z = ds.read(1, masked=True).filled(np.nan).astype(np.float64)
+        res = ds.res[0]
+    gy, gx = np.gradient(np.where(np.isfinite(z), z, np.nanmin(z)), res)
+    slope, aspect = np.arctan(np.hypot(gx, gy)), np.arctan2(-gx, gy)
+    h = np.sin(np.radians(45)) * np.cos(slope) + np.cos(np.radians(45)) * np.sin(slope) * np.cos(
+        np.radians(315) - aspect
+    )
+    hs = cv2.cvtColor((np.clip(h, 0, 1) * 255).astype(np.uint8), cv2.COLOR_GRAY2BGR)
+    hs[~np.isfinite(z)] = (0, 0, 255)
+    with rasterio.open(os.path.join(products, "trueortho.tif")) as ds:
+        a = np.moveaxis(ds.read([1, 2, 3]), 0, -1)[:, :, ::-1].copy()
+        a[ds.dataset_mask() == 0] = (255, 0, 255)
+    rows, cols = min(hs.shape[0], a.shape[0]), min(hs.shape[1], a.shape[1])
+    out = np.hstack([hs[:rows, :cols], a[:rows, :cols]])
+    scale = min(1.0, 1600.0 / out.shape[1])
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    cv2.imwrite(path, cv2.resize(out, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA))
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--blocks", default="sample", help=f"comma-separated, of {', '.join(BLOCKS)}")
+    ap.add_argument("--resolution", type=float, default=0.0, help="RESOLUTION of the pipeline (0 = the GSD)")
+    ap.add_argument("--keep", default="", help="keep the products in this folder")
+    ap.add_argument("--write-docs", action="store_true", help=f"update the marked section of {DOCS}")
+    args = ap.parse_args(argv)
+    names = [b for b in args.blocks.split(",") if b]
+    for b in names:
+        if b not in BLOCKS:
+            raise SystemExit(f"--blocks: unknown block {b!r} (expected {', '.join(BLOCKS)})")
+    work = args.keep or tempfile.mkdtemp(prefix="truortho-real-")
+    rows = [
+        run_block(b, os.path.join(work, b), args.resolution, lambda m: print(m, flush=True)) for b in names
+    ]
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()  # fmt: skip
+    cmd = "python -P bench/real_blocks.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    lines = [
+        f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {os.cpu_count()} cores",
+        "",
+        "| block | cells (res m) | area seen by >= 2 photos m^2 | completeness | raw holes | holes >= 1 m^2 "
+        "| roughness m | streak index | ortho empty (frame / seen by 2) | speckle | occluded | s |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['block']} | {r['cells']} ({r['resolution']:.3f}) | {r['area_seen2_m2']:.0f} | "
+            f"{100 * r['completeness']:.1f} % | {100 * r['raw_holes']:.1f} % | {r['holes_over_1m2']} | "
+            f"{r['roughness_m']:.3f} | {r['streak_index']:.2f} | {100 * r['ortho_empty']:.1f} / "
+            f"{100 * r['ortho_empty_seen2']:.1f} % | {r['ortho_speckle']} | {r['occlusion_flagged']} | "
+            f"{r['seconds']:.0f} |"
+        )
+    text = "\n".join(lines)
+    print("\n" + text)
+    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
+    with open(os.path.join(HERE, "results", "real_blocks.json"), "w") as fh:
+        json.dump({"command": cmd, "commit": commit, "rows": rows}, fh, indent=1)
+    if args.write_docs:
+        begin, end = "<!-- real:begin -->", "<!-- real:end -->"
+        doc = open(DOCS, encoding="utf-8").read()
+        if begin not in doc or end not in doc:
+            raise SystemExit(f"{DOCS}: the markers {begin} / {end} are missing")
+        new = doc[: doc.index(begin) + len(begin)] + "\n" + text + "\n" + doc[doc.index(end) :]
+        with open(DOCS + ".tmp", "w", encoding="utf-8") as fh:
+            fh.write(new)
+        os.replace(DOCS + ".tmp", DOCS)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
