@@ -30,7 +30,6 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
-import resource
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from .errors import InputError
+from .memory import peak_rss_mb
 from .progress import Progress, Steps, as_progress, check
 from .report import Report, Table
 
@@ -112,8 +112,15 @@ class _Stages:
         self._name, self._t = name, time.perf_counter()
 
     def stop(self, note: str = "") -> None:
-        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-        self.rows.append([self._name, round(time.perf_counter() - self._t, 2), round(peak, 1), note])
+        peak = peak_rss_mb()
+        self.rows.append(
+            [
+                self._name,
+                round(time.perf_counter() - self._t, 2),
+                None if peak is None else round(peak, 1),
+                note,
+            ]
+        )
 
 
 def _paths(folder: Path) -> dict[str, str]:
@@ -279,7 +286,7 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
         "osgm": osgm.stats,
         "trueortho": {k: v for k, v in st.items() if isinstance(v, int | float | str)},
         "filter": fstats.summary(),
-        "peak_mb": max(r[2] for r in stages.rows),
+        "peak_mb": max((r[2] for r in stages.rows if r[2] is not None), default=None),
         "executor": ran_on,
     }
     progress.update(1.0, "pipeline done")

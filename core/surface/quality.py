@@ -163,8 +163,8 @@ def streak_index(
     taper = np.outer(np.hanning(rows + 2)[1:-1], np.hanning(cols + 2)[1:-1])
     taper *= _soft_mask(ok, max(1, int(math.ceil(min_wavelength))))
     power = np.abs(np.fft.rfft2(resid * taper)) ** 2
-    fy = np.fft.fftfreq(rows)[:, None]
-    fx = np.fft.rfftfreq(cols)[None, :]
+    fy = np.fft.fftfreq(rows, d=1.0)[:, None]
+    fx = np.fft.rfftfreq(cols, d=1.0)[None, :]
     radius = np.hypot(fx, fy)
     band = (radius >= 1.0 / max_wavelength) & (radius <= 1.0 / min_wavelength)
     # direction of the frequency vector folded onto [0, 180) degrees (rfft keeps fx >= 0)
@@ -176,7 +176,7 @@ def streak_index(
     # wide), so that every wavelength of the band weighs the same whatever the spectral slope of the
     # relief; the median, not the mean, so that the power of a streak does not whiten itself away
     ring = np.broadcast_to(np.rint(radius * min(rows, cols)).astype(np.int64), power.shape)[band]
-    p = power[band]
+    p: np.ndarray = power[band]
     order = np.argsort(ring, kind="stable")
     starts = np.flatnonzero(np.r_[True, np.diff(ring[order]) != 0])
     ring_median = np.empty(len(p))
@@ -184,7 +184,7 @@ def streak_index(
         ring_median[order[a:b]] = np.median(p[order[a:b]])
     if not (ring_median > 0).all():
         return 1.0
-    p = p / ring_median
+    p = p.astype(np.float64) / ring_median
     count = np.bincount(s, minlength=sectors).astype(np.float64)
     if (count == 0).any():
         raise InputError(f"dsm: {z.shape} is too small for {sectors} sectors in the wavelength band")
