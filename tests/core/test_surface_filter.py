@@ -136,6 +136,59 @@ def test_holes_plane_exact_wall_foot_from_ground_large_hole_stays():
     assert np.array_equal(np.isfinite(out[:, :]), ~np.isnan(out))
 
 
+def test_narrow_bays_open_to_the_outside_are_filled_the_wide_outside_is_not():
+    """A gap narrower than max_hole that opens onto the nodata around the data (a vegetated
+    border that lost its low-confidence cells) is filled from its rim, like an enclosed hole;
+    the wide nodata beyond the data (and the corners of a wide enclosed hole) stay nodata, and
+    nothing is extrapolated towards the raster's border."""
+    res = 0.5
+    rows, cols = 100, 120
+    grid = RasterGrid(500000.0, 5600000.0, res, rows, cols, "EPSG:32632")
+    X, Y = grid.centres()
+    plane = 50.0 + 0.02 * (X - 500000.0) - 0.03 * (Y - 5600000.0)
+    z = plane.copy()
+    z[:, 90:] = np.nan  # the outside: 15 m of nodata up to the raster's east border
+    z[40:48, 60:90] = np.nan  # a bay 4 m wide, 15 m deep, open onto the outside
+    z[70:100, 10:50] = np.nan  # 15 x 20 m open onto the south border: stays (corners too)
+    cfg = DsmFilterConfig(max_hole=6.0, sharpen=False)
+    out, stats = filter_dsm_array(z, grid, config=cfg)
+    np.testing.assert_allclose(out[40:48, 60:88], plane[40:48, 60:88], atol=0.05)
+    assert np.isnan(out[:, 92:]).all()  # no extrapolation into the outside
+    assert np.isnan(out[72:100, 12:48]).all()
+    # the wide holes are still reported as remaining, their narrow gaps as filled cells
+    assert stats.holes_remaining >= 1 and stats.cells_filled >= 8 * 28
+    assert stats.valid_output == int(np.isfinite(out).sum())
+    # the same result on small tiles
+    small, _ = filter_dsm_array(z, grid, config=DsmFilterConfig(max_hole=6.0, sharpen=False, tile=32))
+    np.testing.assert_array_equal(np.isfinite(small), np.isfinite(out))
+    np.testing.assert_allclose(small, out, atol=0.05)
+    # a bay running up a 45 degree slope is a ramp from its whole rim, not flat from its lowest cell
+    steep = 50.0 + 1.0 * (X - 500000.0)
+    zs = np.where(np.isnan(z), np.nan, steep)
+    out_s, _ = filter_dsm_array(zs, grid, config=cfg)
+    # (towards its mouth the zero-flux boundary onto the open side flattens it a little)
+    np.testing.assert_allclose(out_s[40:48, 60:80], steep[40:48, 60:80], atol=0.3)
+    assert np.abs(out_s[40:48, 60:88] - steep[40:48, 60:88]).max() < 2.0  # flat would be 14 m off
+
+
+def test_small_islands_are_judged_by_their_surroundings():
+    """A few valid cells alone in a hole have only themselves as support and median: the island
+    test removes them when they depart from the valid cells around them, keeps them otherwise."""
+    res = 0.5
+    grid = RasterGrid(500000.0, 5600000.0, res, 60, 60, "EPSG:32632")
+    X, Y = grid.centres()
+    plane = 20.0 + 0.05 * (X - 500000.0)
+    z = plane.copy()
+    z[20:40, 10:30] = np.nan  # a hole
+    z[24:26, 14:16] = plane[24:26, 14:16] + 5.0  # a 2 x 2 false match 5 m up in it
+    z[33:35, 23:25] = plane[33:35, 23:25]  # a true 2 x 2 patch of ground in it
+    cfg = DsmFilterConfig(max_hole=20.0, sharpen=False)
+    out, stats = filter_dsm_array(z, grid, config=cfg)
+    assert stats.outliers_removed == 4
+    np.testing.assert_allclose(out[20:40, 10:30], plane[20:40, 10:30], atol=0.05)  # no cone
+    np.testing.assert_array_equal(F._islands(z, 1.0, 12)[33:35, 23:25], False)
+
+
 def test_sharpening_and_smoothing_keep_edges_and_reduce_noise():
     rng = np.random.default_rng(2)
     res = 0.25
