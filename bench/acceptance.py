@@ -24,8 +24,11 @@ Per scene, against the exact truth on the truth DSM's grid (the scene extent at 
   misses); wall seconds and seconds per million (cells x images);
 * the **pairwise OpenCV SGBM baseline** (``bench/sgbm_baseline.py``: rectified pairs, SGBM 3WAY,
   triangulation, median fusion onto the same grid), the same figures and its wall seconds;
-* the **true ortho** (:func:`truortho.core.ortho.pipeline.true_ortho`, defaults) on the truth DSM
-  and on the OSGM DSM, and the conventional ortho (``visibility=False``) on the truth DSM:
+* the OSGM DSM after the DSM filter with its confidence (``osgm_filtered``: what
+  ``truortho:pipeline`` hands on to the true ortho), the same figures (informative);
+* the **true ortho** (:func:`truortho.core.ortho.pipeline.true_ortho`, defaults) on the truth DSM,
+  on the raw OSGM DSM (``ortho_osgm``, the goal) and on the filtered one (``ortho_filtered``), and the
+  conventional ortho (``visibility=False``) on the truth DSM:
   ghosting, median shift, coverage and mean dE (``core/ortho/evaluate.py``), and the share of
   cells seen by no image (truth, eroded by one cell) that carry a colour ("wrong fill").
 
@@ -271,6 +274,7 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho
     from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
     from truortho.core.rasterio_io import read_raster
+    from truortho.core.surface.filter import filter_dsm
     from truortho.core.surface.quality import streak_index
     from truortho.core.synthetic import make_scene
 
@@ -305,7 +309,7 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     }
 
     zlo, zhi = float(np.nanmin(truth)) - 5.0, float(np.nanmax(truth)) + 5.0
-    out = OsgmOutputs(dsm=os.path.join(folder, "osgm.tif"))
+    out = OsgmOutputs(dsm=os.path.join(folder, "osgm.tif"), confidence=os.path.join(folder, "osgm_conf.tif"))
     t = time.perf_counter()
     run_osgm(scene.orientation, OsgmConfig(resolution=res, z_min=zlo, z_max=zhi), scene.extent_world(), out,
              folder)  # fmt: skip
@@ -317,6 +321,14 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     row["osgm"]["seconds"] = t_osgm
     row["osgm"]["s_per_mcell_image"] = t_osgm / (grid.rows * grid.cols * n_images / 1e6)
     log(f"  OSGM {t_osgm:.1f} s: {_fmt(row['osgm'])}")
+
+    # the DSM the pipeline hands on: OSGM's, filtered with its confidence (truortho:dsmfilter defaults)
+    t = time.perf_counter()
+    filter_dsm(out.dsm, os.path.join(folder, "osgm_filtered.tif"), out.confidence)
+    filtered, _, _ = read_raster(os.path.join(folder, "osgm_filtered.tif"))
+    row["osgm_filtered"] = dsm_figures(filtered, truth, seen2, edge, gsd)
+    row["osgm_filtered"]["seconds"] = time.perf_counter() - t
+    log(f"  OSGM + DSM filter: {_fmt(row['osgm_filtered'])}")
 
     if sgbm:
         sys.path.insert(0, HERE)
@@ -331,8 +343,13 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
         row["osgm_over_sgbm_time"] = t_osgm / t_sgbm
         log(f"  SGBM {t_sgbm:.1f} s: {_fmt(row['sgbm'])}")
 
-    for key, surface, vis in (("ortho_truth", "dsm.tif", True), ("ortho_conventional", "dsm.tif", False),
-                              ("ortho_osgm", "osgm.tif", True)):  # fmt: skip
+    runs = (
+        ("ortho_truth", "dsm.tif", True),
+        ("ortho_conventional", "dsm.tif", False),
+        ("ortho_osgm", "osgm.tif", True),
+        ("ortho_filtered", "osgm_filtered.tif", True),
+    )
+    for key, surface, vis in runs:
         path = os.path.join(folder, f"{key}.tif")
         t = time.perf_counter()
         occ = os.path.join(folder, f"{key}_occ.tif")
@@ -429,7 +446,9 @@ def summary(rows: list[dict]) -> list[str]:
             f"| OSGM time / SGBM time | <= 1 | {np.median(ratio):.3g} | {ratio.max():.3g} | "
             f"{int((ratio <= 1).sum())} / {len(rows)} |"
         )
-    for name in ("ortho_truth.relative_dE", "ortho_osgm.mean_dE", "ortho_osgm.relative_dE",
+    for name in ("osgm_filtered.completeness", "osgm_filtered.nmad_gsd", "osgm_filtered.flat3",
+                 "osgm_filtered.edge3", "ortho_filtered.ghosting", "ortho_filtered.shift_gsd",
+                 "ortho_truth.relative_dE", "ortho_osgm.mean_dE", "ortho_osgm.relative_dE",
                  "ortho_conventional.ghosting", "osgm.streak_index", "truth_streak_index"):  # fmt: skip
         vals = np.array([value(r, name) if "." in name else r[name] for r in rows])
         lines.append(f"| {name} (not a goal) | | {np.nanmedian(vals):.4g} | {np.nanmax(vals):.4g} | |")
