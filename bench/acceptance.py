@@ -369,39 +369,51 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     return row
 
 
-def pictures(folder: str, path: str) -> None:
-    """One JPEG per scene: hillshades of the truth and OSGM DSMs over the true orthos on them."""
+def hillshade_bgr(path: str) -> np.ndarray:
+    """Hillshade (BGR uint8, light from the north-west at 45 degrees) of a DSM; holes red."""
     import cv2
     import rasterio
 
-    def hillshade(name: str) -> np.ndarray:
-        with rasterio.open(os.path.join(folder, name)) as ds:
-            z = ds.read(1, masked=True).filled(np.nan).astype(np.float64)
-            res = ds.res[0]
-        gy, gx = np.gradient(np.where(np.isfinite(z), z, np.nanmin(z)), res)
-        slope, aspect = np.arctan(np.hypot(gx, gy)), np.arctan2(-gx, gy)
-        alt, az = np.radians(45.0), np.radians(315.0)
-        h = np.sin(alt) * np.cos(slope) + np.cos(alt) * np.sin(slope) * np.cos(az - aspect)
-        img = cv2.cvtColor((np.clip(h, 0, 1) * 255).astype(np.uint8), cv2.COLOR_GRAY2BGR)
-        img[~np.isfinite(z)] = (0, 0, 255)  # holes red
-        return img
+    with rasterio.open(path) as ds:
+        z = ds.read(1, masked=True).filled(np.nan).astype(np.float64)
+        res = ds.res[0]
+    gy, gx = np.gradient(np.where(np.isfinite(z), z, np.nanmin(z)), res)
+    slope, aspect = np.arctan(np.hypot(gx, gy)), np.arctan2(-gx, gy)
+    alt, az = np.radians(45.0), np.radians(315.0)
+    h = np.sin(alt) * np.cos(slope) + np.cos(alt) * np.sin(slope) * np.cos(az - aspect)
+    img = cv2.cvtColor((np.clip(h, 0, 1) * 255).astype(np.uint8), cv2.COLOR_GRAY2BGR)
+    img[~np.isfinite(z)] = (0, 0, 255)
+    return img
 
-    def ortho(name: str) -> np.ndarray:
-        with rasterio.open(os.path.join(folder, name)) as ds:
-            a = np.moveaxis(ds.read([1, 2, 3]), 0, -1)[:, :, ::-1].copy()
-            a[ds.dataset_mask() == 0] = (255, 0, 255)  # no data magenta
-        return a
 
-    tiles = [hillshade("dsm.tif"), hillshade("osgm.tif"), ortho("ortho_truth.tif"), ortho("ortho_osgm.tif")]
-    h = min(t.shape[0] for t in tiles)
-    w = min(t.shape[1] for t in tiles)
-    out = np.vstack(
-        [np.hstack([tiles[0][:h, :w], tiles[1][:h, :w]]), np.hstack([tiles[2][:h, :w], tiles[3][:h, :w]])]
-    )
-    scale = min(1.0, 1200.0 / out.shape[1])
+def ortho_bgr(path: str) -> np.ndarray:
+    """The first three bands of an orthophoto as BGR uint8; cells without data magenta."""
+    import rasterio
+
+    with rasterio.open(path) as ds:
+        a = np.moveaxis(ds.read([1, 2, 3]), 0, -1)[:, :, ::-1].copy()
+        a[ds.dataset_mask() == 0] = (255, 0, 255)
+    return a
+
+
+def save_mosaic(rows: list[list[np.ndarray]], path: str, width: float = 1200.0) -> None:
+    """Tiles (cropped to the smallest) in rows, scaled to ``width`` pixels at most, as a JPEG."""
+    import cv2
+
+    h = min(t.shape[0] for r in rows for t in r)
+    w = min(t.shape[1] for r in rows for t in r)
+    out = np.vstack([np.hstack([t[:h, :w] for t in r]) for r in rows])
+    scale = min(1.0, width / out.shape[1])
     os.makedirs(os.path.dirname(path), exist_ok=True)
     cv2.imwrite(path, cv2.resize(out, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA),
                 [cv2.IMWRITE_JPEG_QUALITY, 85])  # fmt: skip
+
+
+def pictures(folder: str, path: str) -> None:
+    """One JPEG per scene: hillshades of the truth and OSGM DSMs over the true orthos on them."""
+    f = lambda name: os.path.join(folder, name)  # noqa: E731
+    save_mosaic([[hillshade_bgr(f("dsm.tif")), hillshade_bgr(f("osgm.tif"))],
+                 [ortho_bgr(f("ortho_truth.tif")), ortho_bgr(f("ortho_osgm.tif"))]], path)  # fmt: skip
 
 
 def _fmt(d: dict) -> str:

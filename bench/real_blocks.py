@@ -168,27 +168,15 @@ def measures(products: str) -> dict:
 
 
 def picture(products: str, path: str) -> None:
-    import cv2
-    import rasterio
+    """The filtered DSM's hillshade beside the true ortho, as a JPEG."""
+    sys.path.insert(0, HERE)
+    from acceptance import hillshade_bgr, ortho_bgr, save_mosaic
 
-    with rasterio.open(os.path.join(products, "dsm.tif")) as ds:
-        z = ds.read(1, masked=True).filled(np.nan).astype(np.float64)
-        res = ds.res[0]
-    gy, gx = np.gradient(np.where(np.isfinite(z), z, np.nanmin(z)), res)
-    slope, aspect = np.arctan(np.hypot(gx, gy)), np.arctan2(-gx, gy)
-    h = np.sin(np.radians(45)) * np.cos(slope) + np.cos(np.radians(45)) * np.sin(slope) * np.cos(
-        np.radians(315) - aspect
-    )
-    hs = cv2.cvtColor((np.clip(h, 0, 1) * 255).astype(np.uint8), cv2.COLOR_GRAY2BGR)
-    hs[~np.isfinite(z)] = (0, 0, 255)
-    with rasterio.open(os.path.join(products, "trueortho.tif")) as ds:
-        a = np.moveaxis(ds.read([1, 2, 3]), 0, -1)[:, :, ::-1].copy()
-        a[ds.dataset_mask() == 0] = (255, 0, 255)
-    rows, cols = min(hs.shape[0], a.shape[0]), min(hs.shape[1], a.shape[1])
-    out = np.hstack([hs[:rows, :cols], a[:rows, :cols]])
-    scale = min(1.0, 1600.0 / out.shape[1])
-    os.makedirs(os.path.dirname(path), exist_ok=True)
-    cv2.imwrite(path, cv2.resize(out, None, fx=scale, fy=scale, interpolation=cv2.INTER_AREA))
+    tiles = [
+        hillshade_bgr(os.path.join(products, "dsm.tif")),
+        ortho_bgr(os.path.join(products, "trueortho.tif")),
+    ]
+    save_mosaic([tiles], path, width=1600.0)
 
 
 def main(argv=None) -> int:
