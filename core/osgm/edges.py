@@ -22,7 +22,10 @@ evidence that no straddling window mixes:
    absolute difference). A 3 x 3 patch straddles an outline by at most one cell.
 5. **Decision**: a cell moves to the other side when that side's cost is below ``ratio`` times
    its own side's, with at least one pair of views on each side; it then takes the other
-   side's median height. Two passes, the second on the updated surface (visibility changes).
+   side's median height. Passes repeat on the updated surface until no cell switches (at most
+   :data:`PASSES`): the outer cells of a fattened band switch first, and their views then clear
+   the next ones (on battery windows 2 -> 6 passes: edge cells within 3 GSD 83.7 -> 85.1 %,
+   66.9 -> 68.2 %, 60.8 -> 63.3 % with 4).
 """
 
 from __future__ import annotations
@@ -35,7 +38,9 @@ from ..jit import njit, pjit, prange
 REACH = 4
 #: A cell switches side only if the other side is this much more photo-consistent.
 RATIO = 0.8
-PASSES = 2
+#: Passes at most (until no cell switches): a fattened band is peeled from its outer edge, one or
+#: two cells a pass, because its inner cells are hidden from the views by the band itself.
+PASSES = REACH + 2
 
 
 @njit
