@@ -36,7 +36,7 @@ bench: setup
 	$(ENV) $(PY) -m pip install -q -r requirements-bench.txt -c constraints.txt
 	@for f in bench/bench_$(BENCH).py; do echo "== $$f"; $(ENV) $(PY) -P $$f || exit 1; done
 
-# Randomized acceptance battery (not a test; about an hour on 2 cores): DSM and true ortho on 12
+# Randomized acceptance battery (not a test; about half an hour on 2 cores): DSM and true ortho on 12
 # synthetic cities drawn from wide ranges, against their truth and a pairwise OpenCV SGBM baseline.
 # make acceptance ACCEPTANCE_ARGS="--only 3,7 --no-sgbm"; --write-docs updates docs/acceptance.md.
 acceptance: setup
