@@ -198,15 +198,18 @@ def _gps_local(exifs, crs_text_, warnings):
         from pyproj.aoi import AreaOfInterest
         from pyproj.database import query_utm_crs_info
 
-        info = query_utm_crs_info(
-            "WGS 84", AreaOfInterest(*(2 * [float(np.nanmean(lon))]), *(2 * [float(np.nanmean(lat))]))[:4]
-        )
+        lon0, lat0 = float(np.nanmean(lon)), float(np.nanmean(lat))
+        # AreaOfInterest(west, south, east, north): a point at the block's mean position
+        aoi = AreaOfInterest(lon0, lat0, lon0, lat0)
+        info = query_utm_crs_info(datum_name="WGS 84", area_of_interest=aoi)
         crs_text_ = f"EPSG:{info[0].code}" if info else None
         if crs_text_ is None:
             return None, None
         warnings.append(f"no CRS given: using {crs_text_} (UTM zone of the GNSS positions)")
-    xyz = transform_points(np.column_stack([lon, lat, alt]), "EPSG:4979", crs_text_)
-    xyz[~np.array(have)] = np.nan
+    has = np.array(have)
+    xyz = np.full((len(exifs), 3), np.nan)
+    # only the images with a position: pyproj's error check refuses NaN coordinates
+    xyz[has] = transform_points(np.column_stack([lon, lat, alt])[has], "EPSG:4979", crs_text_)
     return xyz, crs_text_
 
 

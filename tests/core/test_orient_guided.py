@@ -206,3 +206,29 @@ def test_search_scale_recovers_a_known_baseline():
         search_scale(A0, T, u, f, u * f, fd, np.arange(n + 1), d, (2.0, 1.0))
     with pytest.raises(InputError, match="guided.ratio"):
         search_scale(A0, T, u, f, u * f, fd, np.arange(n + 1), d, (0.5, 10.0), GuidedConfig(ratio=1.5))
+
+
+@pytest.mark.parametrize(
+    ("lat", "lon", "epsg"),
+    [(50.82, -0.14, "EPSG:32630"), (42.53, -83.78, "EPSG:32617"), (-33.87, 151.21, "EPSG:32756")],
+)
+def test_gnss_only_block_gets_the_utm_zone_of_its_positions(lat, lon, epsg):
+    """A block with EXIF GNSS and no CRS or GCPs (a drone flight): UTM zone of the positions, metres."""
+    from truortho.core.geometry.frame import transform_points
+    from truortho.core.sfm.pipeline import _gps_local
+
+    rng = np.random.default_rng(3)
+    exifs = [
+        SimpleNamespace(has_gps=True, latitude=lat + d[0], longitude=lon + d[1], altitude=120.0 + d[2])
+        for d in rng.normal(0.0, [2e-4, 2e-4, 1.0], (5, 3))
+    ]
+    exifs.append(SimpleNamespace(has_gps=False, latitude=None, longitude=None, altitude=None))
+    warnings: list[str] = []
+    xyz, crs = _gps_local(exifs, None, warnings)
+    assert crs == epsg and warnings and epsg in warnings[0]
+    assert np.isnan(xyz[-1]).all() and np.isfinite(xyz[:-1]).all()
+    back = transform_points(xyz[:-1], crs, "EPSG:4979")
+    assert np.allclose(back[:, 1], [e.latitude for e in exifs[:-1]], atol=1e-7)
+    assert np.allclose(back[:, 2], [e.altitude for e in exifs[:-1]], atol=1e-3)
+    # a span of ~40 m in latitude is ~40 m of northing
+    assert 10.0 < np.ptp(xyz[:-1, 1]) < 200.0
