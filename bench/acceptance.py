@@ -258,22 +258,6 @@ def ortho_figures(path: str, truth_rgb, buildings, seen, unseen_core, gsd: float
     }
 
 
-def seen_counts(scene, grid, truth: np.ndarray, max_view_angle: float = 90.0) -> np.ndarray:
-    """Images that see each cell's truth point (within ``max_view_angle`` off nadir)."""
-    X, Y = grid.centres()
-    P = np.column_stack([X.ravel(), Y.ravel(), truth.ravel()])
-    n = np.zeros(len(P), np.int32)
-    cosmax = math.cos(math.radians(max_view_angle))
-    for i, im in enumerate(scene.orientation.images):
-        d = im.C + scene.offset - P
-        cz = d[:, 2] / np.linalg.norm(d, axis=1)
-        todo = cz >= cosmax
-        if todo.any():
-            vis, _, _ = scene.visibility(P[todo], i, tol=0.05)
-            n[np.flatnonzero(todo)[vis]] += 1
-    return n.reshape(grid.shape)
-
-
 # ------------------------------------------------------------------ one scene
 
 
@@ -301,12 +285,12 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     n_images = len(scene.orientation.images)
     log(f"  rendered {n_images} images in {time.perf_counter() - t:.1f} s; grid {grid.rows}x{grid.cols}")
 
-    nvis = seen_counts(scene, grid, truth)
+    nvis = ev.truth_view_counts(scene, grid, tol=0.05)
     seen2 = nvis >= 2
     edge = dsm_masks(truth, gsd, res)
     buildings = ev.building_mask(scene, grid)
     ortho_angle = TrueOrthoConfig().max_view_angle
-    seen_ortho = seen_counts(scene, grid, truth, ortho_angle) >= 1
+    seen_ortho = ev.truth_view_counts(scene, grid, ortho_angle, tol=0.05) >= 1
     unseen_core = binary_erosion(~seen_ortho, iterations=1)
     row: dict = {
         "scene": index,

@@ -135,6 +135,26 @@ def building_mask(scene, grid: RasterGrid) -> np.ndarray:
     return (bid >= 0).reshape(grid.shape)
 
 
+def truth_view_counts(scene, grid: RasterGrid, max_view_angle: float = 90.0, tol: float = 0.02) -> np.ndarray:
+    """Images (rows, cols) int32 that see each cell's truth surface point within ``max_view_angle``.
+
+    :func:`truth_seen` is the same test stopping at the first image; dense matching needs the
+    count (nothing can be matched where fewer than two images see).
+    """
+    if not 0.0 < float(max_view_angle) <= 90.0:
+        raise InputError(f"max_view_angle: expected degrees in (0, 90], got {max_view_angle!r}")
+    P = grid_points(scene, grid)
+    count = np.zeros(len(P), np.int32)
+    cosmax = math.cos(math.radians(max_view_angle))
+    for i, im in enumerate(scene.orientation.images):
+        d = im.C + scene.offset - P
+        todo = d[:, 2] / np.linalg.norm(d, axis=1) >= cosmax
+        if todo.any():
+            vis, _, _ = scene.visibility(P[todo], i, tol=tol)
+            count[np.flatnonzero(todo)[vis]] += 1
+    return count.reshape(grid.shape)
+
+
 def truth_seen(scene, grid: RasterGrid, max_view_angle: float = 90.0, tol: float = 0.02) -> np.ndarray:
     """Cells whose truth surface point is seen by at least one image within ``max_view_angle``."""
     P = grid_points(scene, grid)

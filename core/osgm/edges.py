@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..jit import njit, pjit, prange
 
 #: Cells near a step considered (beyond the matching window's radius, SGM spreads fattening).
@@ -160,17 +161,24 @@ def _consistency(samples: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, 
 
 
 def refine_edges(
-    z: np.ndarray, images, x0: float, y0: float, res: float, step: float, tol: float
+    z: np.ndarray, images, x0: float, y0: float, res: float, step: float, tol: float, cancelled=None
 ) -> np.ndarray:
     """Heights ``z`` (rows, cols, local, NaN = none) with the sides of height steps re-decided.
 
     ``images``: the tile's :class:`~.matching.TileImage` list (their matching band windows);
     ``step``: the smallest height difference (m) that is a step; ``tol``: height tolerance of the
-    visibility march (m). See the module docstring.
+    visibility march (m); ``cancelled``: optional callable, checked between passes (a cancelled
+    refinement returns the heights of the passes done). See the module docstring.
     """
     from scipy.ndimage import binary_dilation, maximum_filter, minimum_filter
 
     z = np.asarray(z, np.float32).copy()
+    if z.ndim != 2:
+        raise InputError(f"refine_edges: expected 2-D heights, got shape {z.shape}")
+    for name, v, ok, want in (("res", res, res > 0, "> 0"), ("step", step, step > 0, "> 0"),
+                              ("tol", tol, tol >= 0, ">= 0")):  # fmt: skip
+        if not (np.isfinite(v) and ok):
+            raise InputError(f"refine_edges: {name} must be a finite number {want}, got {v!r}")
     if len(images) < 2 or not np.isfinite(z).any():
         return z
     stats = []
@@ -183,6 +191,8 @@ def refine_edges(
     dr, dc = np.meshgrid(np.arange(-1, 2), np.arange(-1, 2), indexing="ij")
     dr, dc = dr.ravel(), dc.ravel()
     for _ in range(PASSES):
+        if cancelled is not None and cancelled():
+            break
         finite = np.isfinite(z)
         zmax = maximum_filter(np.where(finite, z, -np.inf), 3)
         zmin = minimum_filter(np.where(finite, z, np.inf), 3)
@@ -197,9 +207,9 @@ def refine_edges(
         lo = np.empty(n)
         hi = np.empty(n)
         mid = np.empty(n)
-        _side_heights(z.astype(np.float64), ri, ci, REACH + 2, lo, hi, mid)
-        cand = np.stack([lo, hi])  # (2, n)
         zz = z.astype(np.float64)
+        _side_heights(zz, ri, ci, REACH + 2, lo, hi, mid)
+        cand = np.stack([lo, hi])  # (2, n)
         X = x0 + (ci + 0.5) * res
         Y = y0 - (ri + 0.5) * res
         cost = np.full((2, n), np.inf)

@@ -181,6 +181,11 @@ def sunlight_many(pts, sun, terr, bld, g, cmax, cbld):
 
 def sun_vector(azimuth_deg: float, elevation_deg: float, strength: float) -> np.ndarray:
     """``(sx, sy, sz, strength)`` of a sun at ``azimuth`` (clockwise from grid north) and ``elevation``."""
+    if not (np.isfinite(azimuth_deg) and 0.0 < elevation_deg <= 90.0 and 0.0 <= strength < 1.0):
+        raise InputError(
+            f"sun_vector: expected a finite azimuth, elevation in (0, 90] and strength in [0, 1), got "
+            f"{azimuth_deg!r}, {elevation_deg!r}, {strength!r}"
+        )
     a, e = np.radians(azimuth_deg), np.radians(elevation_deg)
     return np.array([np.sin(a) * np.cos(e), np.cos(a) * np.cos(e), np.sin(e), float(strength)])
 
@@ -288,8 +293,14 @@ def apply_radiometry(colour: np.ndarray, camera: Camera, radiometry: Radiometry)
 
 def jpeg_roundtrip(image: np.ndarray, quality: int) -> np.ndarray:
     """``image`` (H, W, 3) uint8 RGB encoded as a JPEG at ``quality`` and decoded (0: unchanged)."""
+    if isinstance(quality, bool) or not isinstance(quality, int | np.integer) or not 0 <= quality <= 100:
+        raise InputError(f"jpeg_roundtrip: quality must be an integer in [0, 100], got {quality!r}")
     if not quality:
         return image
+    if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 3:
+        raise InputError(
+            f"jpeg_roundtrip: expected an (H, W, 3) uint8 image, got {image.dtype} {image.shape}"
+        )
     import cv2
 
     ok, buf = cv2.imencode(

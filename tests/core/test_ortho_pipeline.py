@@ -419,3 +419,12 @@ def test_dsm_in_another_crs_is_resampled_onto_the_output_grid(data, tmp_path):
     i1, _, _ = read_raster(r1.source_index)
     i2, _, _ = read_raster(r2.source_index)
     assert (i1 == i2).mean() > 0.95
+
+
+def test_truth_view_counts_agree_with_truth_seen(data):
+    counts = ev.truth_view_counts(data["scene"], data["grid"], 45.0)
+    assert counts.dtype == np.int32 and counts.shape == data["grid"].shape
+    assert np.array_equal(counts >= 1, data["seen"])  # the same test, not stopping at the first image
+    assert (counts >= 2).mean() > 0.8 and counts.max() <= len(data["scene"].orientation.images)
+    with pytest.raises(InputError, match="max_view_angle"):
+        ev.truth_view_counts(data["scene"], data["grid"], 0.0)
