@@ -13,11 +13,15 @@ never computed.
    coverage, then by the angle between their viewing ray and the system's Z
    axis; for each, the pyramid level whose pixel is closest to the cell size
    and the pixel window the tile can project into.
-2. **Costs** per absolute level (a plane ``Z = const`` of the voxel grid):
-   every image is resampled onto the cells that search that level
-   (:func:`~.views.plane_map` + ``cv2.remap``), and
-   :func:`~truortho.core.sgm.multi_image_cost` compares all of them at once
-   (mean of the best pairs: robust to the views that are occluded there).
+2. **Costs** per absolute level (a plane ``Z = const`` of the voxel grid),
+   on the cells that search that level and the margin their windows read
+   (:mod:`.sweep`, the default saturated-gradient measure: every image
+   sampled there, all of them compared at once, mean of the best pairs:
+   robust to the views that are occluded there); the other measures
+   resample every image onto the bounding box of those cells
+   (:func:`~.views.plane_map` + ``cv2.remap``) and call
+   :func:`~truortho.core.sgm.multi_image_cost`. The gradients' saturation
+   scale is one per image for the tile (:func:`.sweep.gradient_scales`).
 3. :func:`~truortho.core.sgm.aggregate` along 8 or 16 paths in XY (P1, P2;
    P2 lowered across edges of a guide image: the images sampled on the
    coarser level's surface, median over the views), :func:`~truortho.core.sgm.select`
@@ -229,6 +233,71 @@ def _median_view(samples: np.ndarray) -> np.ndarray:
         return np.nanmedian(samples, axis=0).astype(np.float32)
 
 
+def _dense_sweep(
+    images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled
+) -> int:
+    """Costs plane by plane, each on the bounding box of the cells that search it (every measure)."""
+    rows, cols = search.shape
+    pad = params.radius + 2
+    scales = None
+    if params.measure == "gradient":
+        from .sweep import gradient_scales
+
+        scales = gradient_scales(images, _remap, x0, y0, res, rows, cols, z_base + 0.5 * (a_min + a_max) * dz)
+    evaluated = 0
+    for a in range(a_min, a_max + 1):
+        if cancelled is not None and cancelled():
+            break
+        need = search & (lo <= a) & (a <= hi)
+        rr = np.nonzero(need.any(axis=1))[0]
+        if rr.size == 0:
+            continue
+        cc = np.nonzero(need.any(axis=0))[0]
+        r0, r1 = max(0, rr[0] - pad), min(rows, rr[-1] + pad + 1)
+        c0, c1 = max(0, cc[0] - pad), min(cols, cc[-1] + pad + 1)
+        # a minimum size keeps the windows of the other measures meaningful
+        if r1 - r0 < 24:
+            r0, r1 = max(0, min(r0, rows - 24)), min(rows, max(r1, r0 + 24))
+        if c1 - c0 < 24:
+            c0, c1 = max(0, min(c0, cols - 24)), min(cols, max(c1, c0 + 24))
+        za = z_base + a * dz
+        bx0, by0 = x0 + c0 * res, y0 - r0 * res
+        slices = np.stack([_remap(im, bx0, by0, res, r1 - r0, c1 - c0, za) for im in images])
+        c_b, _ = multi_image_cost(slices, params.radius, measure=params.measure, scales=scales)
+        ii, jj = np.nonzero(need[r0:r1, c0:c1])
+        gi, gj = ii + r0, jj + c0
+        cost[gi, gj, a - z0[gi, gj]] = c_b[ii, jj]
+        evaluated += 1
+    return evaluated
+
+
+def _sweep(images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled) -> int:
+    """Costs plane by plane on the cells that search each plane only (:mod:`.sweep`, gradient measure)."""
+    from ..sgm.cost import DEFAULT_MIN_VALID
+    from .sweep import PlaneSweep, gradient_scales
+
+    rows, cols = search.shape
+    z_mid = z_base + 0.5 * (a_min + a_max) * dz
+    scales = gradient_scales(images, _remap, x0, y0, res, rows, cols, z_mid)
+    sweep = PlaneSweep(images, rows, cols, params.radius, DEFAULT_MIN_VALID, scales)
+    z0 = np.ascontiguousarray(z0, np.int32)
+    evaluated = 0
+    for a in range(a_min, a_max + 1):
+        if cancelled is not None and cancelled():
+            break
+        need = search & (lo <= a) & (a <= hi)
+        if not need.any():
+            continue
+        sweep.plane(x0, y0, res, z_base + a * dz, need, a, z0, cost)
+        evaluated += 1
+    return evaluated
+
+
+#: Evaluate the gradient cost on the cells that search each plane only (:mod:`.sweep`); False: the
+#: dense evaluation over each plane's bounding box (kept for the other measures and for comparison).
+SPARSE_SWEEP = True
+
+
 @dataclass
 class TileResult:
     z: np.ndarray  # (rows, cols) float32, NaN where rejected
@@ -274,31 +343,14 @@ def match_tile(
     z0 = np.where(search, np.clip(centre - nd // 2, None, lo), 0)
     z0 = np.where(search, np.maximum(z0, hi - nd + 1), 0).astype(np.int32)
     cost = np.full((rows, cols, nd), COST_MAX, np.uint16)
-    pad = params.radius + 2
-    evaluated = 0
-    for a in range(a_min, a_max + 1):
-        if cancelled is not None and cancelled():
-            break
-        need = search & (lo <= a) & (a <= hi)
-        rr = np.nonzero(need.any(axis=1))[0]
-        if rr.size == 0:
-            continue
-        cc = np.nonzero(need.any(axis=0))[0]
-        r0, r1 = max(0, rr[0] - pad), min(rows, rr[-1] + pad + 1)
-        c0, c1 = max(0, cc[0] - pad), min(cols, cc[-1] + pad + 1)
-        # a minimum size keeps the per-slice gradient scale of the cost meaningful
-        if r1 - r0 < 24:
-            r0, r1 = max(0, min(r0, rows - 24)), min(rows, max(r1, r0 + 24))
-        if c1 - c0 < 24:
-            c0, c1 = max(0, min(c0, cols - 24)), min(cols, max(c1, c0 + 24))
-        za = z_base + a * dz
-        bx0, by0 = x0 + c0 * res, y0 - r0 * res
-        slices = np.stack([_remap(im, bx0, by0, res, r1 - r0, c1 - c0, za) for im in images])
-        c_b, _ = multi_image_cost(slices, params.radius, measure=params.measure)
-        ii, jj = np.nonzero(need[r0:r1, c0:c1])
-        gi, gj = ii + r0, jj + c0
-        cost[gi, gj, a - z0[gi, gj]] = c_b[ii, jj]
-        evaluated += 1
+    if params.measure == "gradient" and SPARSE_SWEEP:
+        evaluated = _sweep(
+            images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled
+        )
+    else:
+        evaluated = _dense_sweep(
+            images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled
+        )
     guide = None if guide_z is None else _median_view(sample_surface(images, x0, y0, res, guide_z))
     S = aggregate(cost, params.p1, params.p2, params.paths, z0, guide=guide)
     level, conf = select(S, z0, params.uniqueness, valid=valid_cells(cost) & search)

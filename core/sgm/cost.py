@@ -510,6 +510,12 @@ def _saturate(g, q, v):
         if scale <= 0.0:
             nz = vals[vals > 0.0]
             scale = nz.mean() if nz.size > 0 else 0.0
+    _saturate_with(g, scale, q, v)
+
+
+@njit
+def _saturate_with(g, scale, q, v):
+    """:func:`_saturate` with a given scale (median |g|; 0: every valid gradient quantises to 0)."""
     inv = _GQ / scale if scale > 0.0 else 0.0
     rows, cols = g.shape
     for r in range(rows):
@@ -610,16 +616,26 @@ def _grad_pair(ax, ay, av, bx, by, bv, r0, r1, radius, need, cnta, cntb, out):
                 out[i, c] = np.nan
 
 
+#: ``scales`` of :func:`_prep_gradients` meaning "each slice's own".
+_NO_SCALES = np.zeros((0, 2), np.float64)
+
+
 @pjit
-def _prep_gradients(sl, qx, qy, vv):
+def _prep_gradients(sl, qx, qy, vv, scales):
+    """Saturated gradients of every slice; ``scales`` (n, 2) median |g| along columns and rows,
+    or an empty array: each slice's own (:func:`_saturate`)."""
     n = sl.shape[0]
     for i in prange(n):
         tx = np.empty(sl.shape[1:], np.float32)
         ty = np.empty(sl.shape[1:], np.float32)
         _gradients(sl[i], tx, ty)
         vx = np.empty(sl.shape[1:], np.uint8)
-        _saturate(tx, qx[i], vx)
-        _saturate(ty, qy[i], vv[i])
+        if scales.shape[0] == n:
+            _saturate_with(tx, scales[i, 0], qx[i], vx)
+            _saturate_with(ty, scales[i, 1], qy[i], vv[i])
+        else:
+            _saturate(tx, qx[i], vx)
+            _saturate(ty, qy[i], vv[i])
         vv[i] &= vx
 
 
@@ -727,6 +743,7 @@ def multi_image_cost(
     out: tuple[np.ndarray, np.ndarray] | None = None,
     *,
     min_valid: float = DEFAULT_MIN_VALID,
+    scales: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Matching cost of n images resampled onto one common grid.
 
@@ -767,6 +784,11 @@ def multi_image_cost(
         one level of a cost volume ``cost[:, :, k]``) to write into.
     min_valid : float in (0, 1]
         Fraction of a window that must be valid (module docstring).
+    scales : (n, 2) float array, optional
+        ``"gradient"`` only: the saturation scales (median absolute gradient
+        along columns and along rows) of each image, instead of each slice's
+        own; OSGM takes one per image for a whole tile, so that the costs of
+        all its planes share one scale.
 
     Returns
     -------
@@ -804,7 +826,15 @@ def multi_image_cost(
         qx = np.empty(s.shape, np.int16)
         qy = np.empty(s.shape, np.int16)
         vv = np.empty(s.shape, np.uint8)
-        _prep_gradients(np.ascontiguousarray(s), qx, qy, vv)
+        if scales is None:
+            sc = _NO_SCALES
+        else:
+            sc = np.asarray(scales, np.float64)
+            if sc.shape != (s.shape[0], 2) or not np.all(np.isfinite(sc) & (sc >= 0)):
+                raise InputError(
+                    f"scales: expected ({s.shape[0]}, 2) finite non-negative scales, got shape {sc.shape}"
+                )
+        _prep_gradients(np.ascontiguousarray(s), qx, qy, vv, np.ascontiguousarray(sc))
         _mic_grad_kernel(qx, qy, vv, radius, min_valid, k, _STRIP, cost, nv)
     elif measure == "ncc":
         z, vf = _prepare(s)

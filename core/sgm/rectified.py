@@ -90,7 +90,7 @@ def _gradient_costs(left, right, min_disp, num_disp, radius, min_valid, cost, nv
     (not each shifted slice's) and the slice edges use the extended image's
     central differences.
     """
-    from .cost import _STRIP, _mic_grad_kernel, _prep_gradients
+    from .cost import _NO_SCALES, _STRIP, _mic_grad_kernel, _prep_gradients
 
     h, w = left.shape
     lo = max(0, min_disp + num_disp - 1)  # columns added left of the right image
@@ -98,9 +98,9 @@ def _gradient_costs(left, right, min_disp, num_disp, radius, min_valid, cost, nv
     ext = np.concatenate([np.repeat(right[:, :1], lo, 1), right, np.repeat(right[:, -1:], hi, 1)], axis=1)
     we = ext.shape[1]
     ql = [np.empty((1, h, w), np.int16) for _ in range(2)] + [np.empty((1, h, w), np.uint8)]
-    _prep_gradients(left[None], ql[0], ql[1], ql[2])
+    _prep_gradients(left[None], ql[0], ql[1], ql[2], _NO_SCALES)
     qr = [np.empty((1, h, we), np.int16) for _ in range(2)] + [np.empty((1, h, we), np.uint8)]
-    _prep_gradients(np.ascontiguousarray(ext[None]), qr[0], qr[1], qr[2])
+    _prep_gradients(np.ascontiguousarray(ext[None]), qr[0], qr[1], qr[2], _NO_SCALES)
     pair = [np.empty((2, h, w), a.dtype) for a in ql]
     for a, b in zip(pair, ql, strict=True):
         a[0] = b[0]

@@ -530,7 +530,7 @@ def test_kernels_pure_python_on_tiny_inputs(rng):
     qx = np.empty(s.shape, np.int16)
     qy = np.empty(s.shape, np.int16)
     vv = np.empty(s.shape, np.uint8)
-    cost_mod._prep_gradients.py_func(s, qx, qy, vv)
+    cost_mod._prep_gradients.py_func(s, qx, qy, vv, cost_mod._NO_SCALES)
     cost_mod._mic_grad_kernel.py_func(qx, qy, vv, 1, 0.5, 0, 4, c, nv)
     assert np.abs(c.astype(int) - ref_gradient_cost(s, 1)[0]).max() <= 1
     tx = np.empty((6, 7), np.float32)

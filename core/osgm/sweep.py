@@ -1,0 +1,420 @@
+"""The plane sweep of one OSGM tile on the cells that search each plane only.
+
+On a refined pyramid level a cell searches a band of a few tens of Z levels
+around the coarser result, but the tile as a whole spans ground to roof: a
+plane ``Z = const`` is searched by a thin, scattered set of cells (the
+outlines of the buildings at that height, the ground around them, ...).
+Resampling every image onto the whole bounding box of that set and running
+the dense cost over it spent 6 to 27 times the work the cells need
+(measured on the acceptance battery's tiles). This module evaluates a plane
+on the cells that search it, and on the margin their windows read, with the
+same arithmetic as the dense saturated-gradient cost
+(:func:`~truortho.core.sgm.multi_image_cost`, ``measure="gradient"``):
+
+1. every image is sampled (bilinear, NaN outside its window) at the cells
+   within ``radius + 1`` of a searching cell (:func:`sample_plane` logic in
+   :func:`_sweep_plane`);
+2. gradients along rows and columns (central, one-sided next to missing
+   samples), divided by a saturation scale and clipped to ``[-1, 1]``,
+   quantised to int16, at the cells within ``radius``;
+3. for every searching cell, the window sums of every pair (running sums
+   along the rows of a strip and along runs of searching cells), the pair
+   contributions ``min(1, mean (|dgx| + |dgy|) / 2)`` and the mean of the
+   best pairs (:func:`~truortho.core.sgm.cost._combine`), written straight
+   into the tile's cost volume.
+
+The saturation scale is one per image and axis for the whole tile
+(:func:`gradient_scales`: the median absolute gradient of the image sampled
+on the tile's middle plane), so costs of different planes and of different
+parts of the tile share one scale.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..jit import njit, pjit, prange
+from ..sgm import COST_MAX
+from ..sgm.cost import _GQ, _combine, _diff1, _need, _window_cells
+
+#: Rows per parallel strip of the window sums.
+STRIP = 32
+#: Subpixel steps of the bilinear sampler (cv2.remap's ``INTER_TAB_SIZE``).
+_SUB = 32
+
+
+class PackedImages:
+    """The tile's image windows and cameras as flat arrays for the kernels."""
+
+    def __init__(self, images) -> None:
+        n = len(images)
+        sizes = [im.window.size for im in images]
+        self.off = np.zeros(n, np.int64)
+        if n > 1:
+            self.off[1:] = np.cumsum(sizes)[:-1]
+        self.buf = np.concatenate([np.ascontiguousarray(im.window, np.float32).ravel() for im in images])
+        self.hh = np.array([im.window.shape[0] for im in images], np.int64)
+        self.ww = np.array([im.window.shape[1] for im in images], np.int64)
+        self.R = np.ascontiguousarray(np.stack([im.view.R for im in images]), np.float64)
+        self.C = np.ascontiguousarray(np.stack([im.view.C for im in images]), np.float64)
+        self.P = np.ascontiguousarray(np.stack([im.view.camera.params for im in images]), np.float64)
+        self.r2max = np.array([im.view.r2max for im in images], np.float64)
+        self.scale = np.array([0.5**im.level for im in images], np.float64)
+        self.shift = np.array([im.origin for im in images], np.float64).reshape(n, 2)
+
+    @property
+    def n(self) -> int:
+        return len(self.off)
+
+
+@njit
+def _sample_one(buf, off, h, w, R, C, p, r2max, scl, su, sv, X, Y, Z):
+    """Bilinear sample of one image window at the object point (NaN: not seen or outside)."""
+    dx = X - C[0]
+    dy = Y - C[1]
+    dz = Z - C[2]
+    zc = R[2, 0] * dx + R[2, 1] * dy + R[2, 2] * dz
+    if zc <= 0.0:
+        return np.nan
+    xn = (R[0, 0] * dx + R[0, 1] * dy + R[0, 2] * dz) / zc
+    yn = (R[1, 0] * dx + R[1, 1] * dy + R[1, 2] * dz) / zc
+    r2 = xn * xn + yn * yn
+    if r2 > r2max:
+        return np.nan
+    radial = 1.0 + r2 * (p[4] + r2 * (p[5] + r2 * p[6]))
+    xd = xn * radial + 2.0 * p[7] * xn * yn + p[8] * (r2 + 2.0 * xn * xn)
+    yd = yn * radial + p[7] * (r2 + 2.0 * yn * yn) + 2.0 * p[8] * xn * yn
+    u = ((p[0] * xd + p[2]) + 0.5) * scl - 0.5 - su
+    v = ((p[1] * yd + p[3]) + 0.5) * scl - 0.5 - sv
+    if not (u >= 0.0 and v >= 0.0 and u <= w - 1 and v <= h - 1):
+        return np.nan
+    # positions rounded to 1/32 pixel, as cv2.remap does (a neighbour of weight 0 is not read)
+    qu = int(u * _SUB + 0.5)
+    qv = int(v * _SUB + 0.5)
+    iu = min(qu // _SUB, w - 2) if w > 1 else 0
+    iv = min(qv // _SUB, h - 2) if h > 1 else 0
+    fu = (qu - iu * _SUB) / _SUB
+    fv = (qv - iv * _SUB) / _SUB
+    k = off + iv * w + iu
+    a = buf[k]
+    b = buf[k + 1] if w > 1 else a
+    if h > 1:
+        c = buf[k + w]
+        d = buf[k + w + 1] if w > 1 else c
+    else:
+        c = a
+        d = b
+    return (a * (1.0 - fu) + b * fu) * (1.0 - fv) + (c * (1.0 - fu) + d * fu) * fv
+
+
+@njit
+def _box(mask, margin):
+    """Bounding box ``(r0, r1, c0, c1)`` of a uint8 mask widened by ``margin`` (clipped; empty: r0 = r1)."""
+    rows, cols = mask.shape
+    r0, r1, c0, c1 = rows, -1, cols, -1
+    for r in range(rows):
+        for c in range(cols):
+            if mask[r, c]:
+                r0 = min(r0, r)
+                r1 = max(r1, r)
+                c0 = min(c0, c)
+                c1 = max(c1, c)
+    if r1 < 0:
+        return 0, 0, 0, 0
+    return max(0, r0 - margin), min(rows, r1 + margin + 1), max(0, c0 - margin), min(cols, c1 + margin + 1)
+
+
+@njit
+def _dilate(mask, rad, box, tmp, out):
+    """Box dilation (``(2 rad + 1)^2``) of a uint8 mask inside ``box`` (separable running counts).
+
+    Only the cells of ``box`` are written; the mask must be zero outside it.
+    """
+    b0, b1, d0, d1 = box[0], box[1], box[2], box[3]
+    for r in range(b0, b1):
+        acc = 0
+        for c in range(d0, min(d1, d0 + rad)):
+            acc += mask[r, c]
+        for c in range(d0, d1):
+            if c + rad < d1:
+                acc += mask[r, c + rad]
+            if c - rad - 1 >= d0:
+                acc -= mask[r, c - rad - 1]
+            tmp[r, c] = 1 if acc > 0 else 0
+    for c in range(d0, d1):
+        acc = 0
+        for r in range(b0, min(b1, b0 + rad)):
+            acc += tmp[r, c]
+        for r in range(b0, b1):
+            if r + rad < b1:
+                acc += tmp[r + rad, c]
+            if r - rad - 1 >= b0:
+                acc -= tmp[r - rad - 1, c]
+            out[r, c] = 1 if acc > 0 else 0
+
+
+@njit
+def _quantise(g, inv):
+    return np.int16(round(min(float(_GQ), max(-float(_GQ), g * inv))))
+
+
+@njit
+def _add_row(qx, qy, vv, rr, cc, n, sign, vd, vm, vc):
+    """Adds (sign +1) or removes (-1) sample (rr, cc) to the column sums of every pair and image."""
+    p = 0
+    for i in range(n):
+        ai = np.int32(vv[rr, cc, i])
+        vc[cc, i] += sign * ai
+        xi = np.int32(qx[rr, cc, i])
+        yi = np.int32(qy[rr, cc, i])
+        for j in range(i + 1, n):
+            m = ai & np.int32(vv[rr, cc, j])
+            d = abs(xi - np.int32(qx[rr, cc, j])) + abs(yi - np.int32(qy[rr, cc, j]))
+            vd[cc, p] += sign * d * m
+            vm[cc, p] += sign * m
+            p += 1
+
+
+@pjit
+def _sweep_plane(
+    buf, off, hh, ww, R, C, P, r2max, scl, shift, inv,
+    x0, y0, res, z, need, samp, win, box, radius, min_valid, best_k,
+    s, qx, qy, vv, a, z0, cost,
+):  # fmt: skip
+    """Cost of plane ``z`` (level ``a``) at the cells with ``need`` into ``cost[r, c, a - z0[r, c]]``.
+
+    ``samp``/``win``: ``need`` dilated by ``radius + 1`` and ``radius`` (uint8),
+    valid inside ``box`` (``r0, r1, c0, c1``: the cells of ``samp``) only.
+    ``s`` (rows, cols, n) float32, ``qx``, ``qy`` int16 and ``vv`` uint8 are
+    work arrays, read only where this call wrote them.
+    """
+    rows, cols = need.shape
+    n = off.shape[0]
+    b0, b1, d0, d1 = box[0], box[1], box[2], box[3]
+    # 1. samples
+    for r in prange(b0, b1):
+        Y = y0 - (r + 0.5) * res
+        for c in range(d0, d1):
+            if samp[r, c] == 0:
+                continue
+            X = x0 + (c + 0.5) * res
+            for i in range(n):
+                s[r, c, i] = _sample_one(
+                    buf,
+                    off[i],
+                    hh[i],
+                    ww[i],
+                    R[i],
+                    C[i],
+                    P[i],
+                    r2max[i],
+                    scl[i],
+                    shift[i, 0],
+                    shift[i, 1],
+                    X,
+                    Y,
+                    z,
+                )
+    # 2. saturated, quantised gradients
+    for r in prange(b0, b1):
+        for c in range(d0, d1):
+            if win[r, c] == 0:
+                continue
+            for i in range(n):
+                x = s[r, c, i]
+                al = s[r, c - 1, i] if c > 0 and samp[r, c - 1] else np.float32(np.nan)
+                ar = s[r, c + 1, i] if c < cols - 1 and samp[r, c + 1] else np.float32(np.nan)
+                au = s[r - 1, c, i] if r > 0 and samp[r - 1, c] else np.float32(np.nan)
+                ad = s[r + 1, c, i] if r < rows - 1 and samp[r + 1, c] else np.float32(np.nan)
+                gx = _diff1(al, x, ar)
+                gy = _diff1(au, x, ad)
+                if gx != gx or gy != gy:
+                    qx[r, c, i] = 0
+                    qy[r, c, i] = 0
+                    vv[r, c, i] = 0
+                else:
+                    qx[r, c, i] = _quantise(gx, inv[i, 0])
+                    qy[r, c, i] = _quantise(gy, inv[i, 1])
+                    vv[r, c, i] = 1
+    # 3. window sums and the multi-image cost
+    npairs = n * (n - 1) // 2
+    nstrips = (b1 - b0 + STRIP - 1) // STRIP
+    cmax = np.float64(COST_MAX)
+    scale = 1.0 / (2.0 * _GQ)
+    for st in prange(nstrips):
+        r0 = b0 + st * STRIP
+        r1 = min(b1, r0 + STRIP)
+        vd = np.zeros((cols, max(1, npairs)), np.int32)
+        vm = np.zeros((cols, max(1, npairs)), np.int32)
+        vc = np.zeros((cols, n), np.int32)
+        last = np.full(cols, -10, np.int64)  # row whose column sums vd/vm/vc hold
+        hd = np.zeros(max(1, npairs), np.int32)
+        hm = np.zeros(max(1, npairs), np.int32)
+        hc = np.zeros(n, np.int32)
+        col = np.empty(max(1, npairs), np.float32)
+        kbuf = np.empty(max(1, npairs), np.float32)
+        for r in range(r0, r1):
+            rlo = max(0, r - radius)
+            rhi = min(rows, r + radius + 1)
+            # column sums at every column within `radius` of a searching cell of this row
+            for cc in range(d0, d1):
+                if win[r, cc] == 0:
+                    continue
+                lo = max(0, cc - radius)
+                hi = min(cols, cc + radius + 1)
+                used = False
+                for c in range(lo, hi):
+                    if need[r, c]:
+                        used = True
+                        break
+                if not used:
+                    continue
+                if last[cc] == r - 1:
+                    if r + radius < rows:
+                        _add_row(qx, qy, vv, r + radius, cc, n, 1, vd, vm, vc)
+                    if r - radius - 1 >= 0:
+                        _add_row(qx, qy, vv, r - radius - 1, cc, n, -1, vd, vm, vc)
+                else:
+                    vd[cc, :] = 0
+                    vm[cc, :] = 0
+                    vc[cc, :] = 0
+                    for rr in range(rlo, rhi):
+                        _add_row(qx, qy, vv, rr, cc, n, 1, vd, vm, vc)
+                last[cc] = r
+            # window sums along runs of searching cells
+            prev = -10
+            for c in range(d0, d1):
+                if need[r, c] == 0:
+                    continue
+                lo = max(0, c - radius)
+                hi = min(cols, c + radius + 1)
+                if prev == c - 1:
+                    if c + radius < cols:
+                        for q in range(npairs):
+                            hd[q] += vd[c + radius, q]
+                            hm[q] += vm[c + radius, q]
+                        for i in range(n):
+                            hc[i] += vc[c + radius, i]
+                    if c - radius - 1 >= 0:
+                        for q in range(npairs):
+                            hd[q] -= vd[c - radius - 1, q]
+                            hm[q] -= vm[c - radius - 1, q]
+                        for i in range(n):
+                            hc[i] -= vc[c - radius - 1, i]
+                else:
+                    hd[:] = 0
+                    hm[:] = 0
+                    hc[:] = 0
+                    for cc in range(lo, hi):
+                        for q in range(npairs):
+                            hd[q] += vd[cc, q]
+                            hm[q] += vm[cc, q]
+                        for i in range(n):
+                            hc[i] += vc[cc, i]
+                prev = c
+                k = _need(_window_cells(r, c, rows, cols, radius), min_valid)
+                nv = 0
+                for i in range(n):
+                    if hc[i] >= k:
+                        nv += 1
+                kk = a - z0[r, c]
+                if nv < 2:
+                    cost[r, c, kk] = COST_MAX
+                    continue
+                q = 0
+                for i in range(n):
+                    for j in range(i + 1, n):
+                        if hc[i] >= k and hc[j] >= k and hm[q] >= k:
+                            col[q] = min(1.0, hd[q] * scale / hm[q])
+                        else:
+                            col[q] = np.nan
+                        q += 1
+                m = _combine(col, npairs, nv, best_k, kbuf)
+                if m < 0.0:
+                    cost[r, c, kk] = COST_MAX
+                else:
+                    cost[r, c, kk] = np.uint16(min(cmax, m * cmax + 0.5))
+
+
+@njit
+def _median_abs_grad(s, axis):
+    """Median |gradient| of one sampled slice (rows, cols) along columns (0) or rows (1), 0 if none."""
+    rows, cols = s.shape
+    vals = np.empty(rows * cols, np.float64)
+    m = 0
+    for r in range(rows):
+        for c in range(cols):
+            if axis == 0:
+                a = s[r, c - 1] if c > 0 else np.nan
+                b = s[r, c + 1] if c < cols - 1 else np.nan
+            else:
+                a = s[r - 1, c] if r > 0 else np.nan
+                b = s[r + 1, c] if r < rows - 1 else np.nan
+            g = _diff1(a, s[r, c], b)
+            if g == g:
+                vals[m] = abs(g)
+                m += 1
+    if m == 0:
+        return 0.0
+    v = vals[:m]
+    med = np.median(v)
+    if med <= 0.0:
+        nz = v[v > 0.0]
+        med = nz.mean() if nz.size > 0 else 0.0
+    return med
+
+
+def gradient_scales(images, sample, x0, y0, res, rows, cols, z) -> np.ndarray:
+    """``(n, 2)`` saturation scales per image: the median |gradient| along columns and along rows.
+
+    ``sample(image, x0, y0, res, rows, cols, z)`` resamples one image onto the
+    plane ``z``; the central 256 x 256 cells of the tile at most (the median
+    of the gradients needs no more). 0 where an image has no gradient there.
+    """
+    h, w = min(rows, 256), min(cols, 256)
+    r0, c0 = (rows - h) // 2, (cols - w) // 2
+    out = np.zeros((len(images), 2), np.float64)
+    for i, im in enumerate(images):
+        sl = np.asarray(sample(im, x0 + c0 * res, y0 - r0 * res, res, h, w, z), np.float64)
+        for ax in (0, 1):
+            out[i, ax] = _median_abs_grad(sl, ax)
+    return out
+
+
+class PlaneSweep:
+    """Work arrays of one tile's sweep, reused for every plane."""
+
+    def __init__(
+        self, images, rows: int, cols: int, radius: int, min_valid: float, scales: np.ndarray
+    ) -> None:
+        self.pack = PackedImages(images)
+        n = self.pack.n
+        self.radius = int(radius)
+        self.min_valid = float(min_valid)
+        sc = np.asarray(scales, np.float64)
+        self.inv = np.ascontiguousarray(np.where(sc > 0.0, _GQ / np.where(sc > 0.0, sc, 1.0), 0.0))
+        self.s = np.empty((rows, cols, n), np.float32)
+        self.qx = np.empty((rows, cols, n), np.int16)
+        self.qy = np.empty((rows, cols, n), np.int16)
+        self.vv = np.empty((rows, cols, n), np.uint8)
+        self.tmp = np.empty((rows, cols), np.uint8)
+        self.samp = np.empty((rows, cols), np.uint8)
+        self.win = np.empty((rows, cols), np.uint8)
+
+    def plane(
+        self, x0, y0, res, z, need: np.ndarray, a: int, z0: np.ndarray, cost: np.ndarray, best_k=0
+    ) -> None:
+        """Costs of plane ``z`` (absolute level ``a``) for the cells with ``need`` into ``cost``."""
+        need8 = np.ascontiguousarray(need, np.uint8)
+        box = np.array(_box(need8, self.radius + 1), np.int64)
+        if box[1] <= box[0]:
+            return
+        _dilate(need8, self.radius + 1, box, self.tmp, self.samp)
+        _dilate(need8, self.radius, box, self.tmp, self.win)
+        p = self.pack
+        _sweep_plane(
+            p.buf, p.off, p.hh, p.ww, p.R, p.C, p.P, p.r2max, p.scale, p.shift, self.inv,
+            float(x0), float(y0), float(res), float(z), need8, self.samp, self.win, box,
+            self.radius, self.min_valid, int(best_k or 0),
+            self.s, self.qx, self.qy, self.vv, int(a), z0, cost,
+        )  # fmt: skip
