@@ -112,7 +112,8 @@ def test_given_scales_equal_to_the_slices_own_give_the_same_cost():
 
     rng = np.random.default_rng(5)
     s = cv2.GaussianBlur(rng.uniform(0, 255, (40, 50)).astype(np.float32), (0, 0), 1.0)
-    slices = np.stack([np.roll(s, k, axis=1) + rng.normal(0, 2, s.shape).astype(np.float32) for k in range(4)])
+    noise = rng.normal(0, 2, (4, *s.shape)).astype(np.float32)
+    slices = np.stack([np.roll(s, k, axis=1) + noise[k] for k in range(4)])
     slices[1, :, :5] = np.nan
     own, _ = multi_image_cost(slices, 2, measure="gradient")
     sc = np.array([[_median_abs_grad(x.astype(np.float64), ax) for ax in (0, 1)] for x in slices])
