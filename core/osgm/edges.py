@@ -76,8 +76,11 @@ def _side_heights(z, rows_idx, cols_idx, w, lo_out, hi_out, mid_out):
 
 
 @pjit
-def _ray_free(z, rows_idx, cols_idx, zc, x0, y0, res, C, tol, out):
-    """Whether the ray from each cell centre at height ``zc[n]`` to ``C`` stays above ``z`` in the tile."""
+def _ray_free(z, rows_idx, cols_idx, zc, x0, y0, res, C, tol, ztop, out):
+    """Whether the ray from each cell centre at height ``zc[n]`` to ``C`` stays above ``z`` in the tile.
+
+    ``ztop``: the tile's highest height; a ray above ``ztop + tol`` is free (the march stops there).
+    """
     rows, cols = z.shape
     for n in prange(rows_idx.shape[0]):
         r = rows_idx[n]
@@ -108,8 +111,8 @@ def _ray_free(z, rows_idx, cols_idx, zc, x0, y0, res, C, tol, out):
                     if zz == zz and zz > ray + tol:
                         free = False
                         break
-                    if ray > 1e4:
-                        break
+                if h + slope * t > ztop + tol:
+                    break
                 t += 0.5 * res
         out[n] = free
 
@@ -208,6 +211,7 @@ def refine_edges(
         hi = np.empty(n)
         mid = np.empty(n)
         zz = z.astype(np.float64)
+        ztop = float(np.nanmax(zz))
         _side_heights(zz, ri, ci, REACH + 2, lo, hi, mid)
         cand = np.stack([lo, hi])  # (2, n)
         X = x0 + (ci + 0.5) * res
@@ -224,7 +228,9 @@ def refine_edges(
             ])  # fmt: skip
             for v, img in enumerate(images):
                 free = np.empty(n, np.bool_)
-                _ray_free(zz, ri, ci, cand[k], x0, y0, res, np.asarray(img.view.C, np.float64), tol, free)
+                _ray_free(
+                    zz, ri, ci, cand[k], x0, y0, res, np.asarray(img.view.C, np.float64), tol, ztop, free
+                )
                 visible[v] = free
                 mu, sd = stats[v]
                 samples[v] = ((_samples(img, P) - mu) / sd).reshape(n, 9)

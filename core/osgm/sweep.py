@@ -11,17 +11,25 @@ on the cells that search it, and on the margin their windows read, with the
 same arithmetic as the dense saturated-gradient cost
 (:func:`~truortho.core.sgm.multi_image_cost`, ``measure="gradient"``):
 
-1. every image is sampled (bilinear, NaN outside its window) at the cells
-   within ``radius + 1`` of a searching cell (:func:`sample_plane` logic in
-   :func:`_sweep_plane`);
+1. every image is sampled (bilinear at 1/32 pixel as ``cv2.remap``, NaN
+   outside its window) at the cells within ``radius + 1`` of a searching
+   cell (:func:`_sample_phase`);
 2. gradients along rows and columns (central, one-sided next to missing
    samples), divided by a saturation scale and clipped to ``[-1, 1]``,
-   quantised to int16, at the cells within ``radius``;
-3. for every searching cell, the window sums of every pair (running sums
-   along the rows of a strip and along runs of searching cells), the pair
+   quantised to int16, at the cells within ``radius`` (:func:`_gradient_phase`);
+3. per sample and pair, ``|dgx| + |dgy|`` and whether both views are valid
+   (:func:`_pair_terms`, evaluated once per sample rather than on entering
+   and on leaving a window);
+4. for every searching cell, the window sums of every pair (running sums
+   down the columns of a strip and along runs of searching cells), the pair
    contributions ``min(1, mean (|dgx| + |dgy|) / 2)`` and the mean of the
    best pairs (:func:`~truortho.core.sgm.cost._combine`), written straight
-   into the tile's cost volume.
+   into the tile's cost volume (:func:`_window_cost`).
+
+Comparing every view with the per-sample median of the views instead of
+every pair (``n`` terms instead of ``n (n - 1) / 2``) was measured on the
+battery and rejected: at most 1.4x faster per tile and 0 to 6 points fewer
+edge cells within 3 GSD (scene 9: 0.688 -> 0.631).
 
 The saturation scale is one per image and axis for the whole tile
 (:func:`gradient_scales`: the median absolute gradient of the image sampled
@@ -68,26 +76,10 @@ class PackedImages:
 
 
 @njit
-def _sample_one(buf, off, h, w, R, C, p, r2max, scl, su, sv, X, Y, Z):
-    """Bilinear sample of one image window at the object point (NaN: not seen or outside)."""
-    dx = X - C[0]
-    dy = Y - C[1]
-    dz = Z - C[2]
-    zc = R[2, 0] * dx + R[2, 1] * dy + R[2, 2] * dz
-    if zc <= 0.0:
-        return np.nan
-    xn = (R[0, 0] * dx + R[0, 1] * dy + R[0, 2] * dz) / zc
-    yn = (R[1, 0] * dx + R[1, 1] * dy + R[1, 2] * dz) / zc
-    r2 = xn * xn + yn * yn
-    if r2 > r2max:
-        return np.nan
-    radial = 1.0 + r2 * (p[4] + r2 * (p[5] + r2 * p[6]))
-    xd = xn * radial + 2.0 * p[7] * xn * yn + p[8] * (r2 + 2.0 * xn * xn)
-    yd = yn * radial + p[7] * (r2 + 2.0 * yn * yn) + 2.0 * p[8] * xn * yn
-    u = ((p[0] * xd + p[2]) + 0.5) * scl - 0.5 - su
-    v = ((p[1] * yd + p[3]) + 0.5) * scl - 0.5 - sv
+def _bilinear(buf, off, h, w, u, v):
+    """Bilinear sample of the window ``buf[off:off + h w]`` (row-major ``h x w``) at pixel ``(u, v)``."""
     if not (u >= 0.0 and v >= 0.0 and u <= w - 1 and v <= h - 1):
-        return np.nan
+        return np.float32(np.nan)
     # positions rounded to 1/32 pixel, as cv2.remap does (a neighbour of weight 0 is not read)
     qu = int(u * _SUB + 0.5)
     qv = int(v * _SUB + 0.5)
@@ -104,7 +96,7 @@ def _sample_one(buf, off, h, w, R, C, p, r2max, scl, su, sv, X, Y, Z):
     else:
         c = a
         d = b
-    return (a * (1.0 - fu) + b * fu) * (1.0 - fv) + (c * (1.0 - fu) + d * fu) * fv
+    return np.float32((a * (1.0 - fu) + b * fu) * (1.0 - fv) + (c * (1.0 - fu) + d * fu) * fv)
 
 
 @njit
@@ -158,66 +150,53 @@ def _quantise(g, inv):
     return np.int16(round(min(float(_GQ), max(-float(_GQ), g * inv))))
 
 
-@njit
-def _add_row(qx, qy, vv, rr, cc, n, sign, vd, vm, vc):
-    """Adds (sign +1) or removes (-1) sample (rr, cc) to the column sums of every pair and image."""
-    p = 0
-    for i in range(n):
-        ai = np.int32(vv[rr, cc, i])
-        vc[cc, i] += sign * ai
-        xi = np.int32(qx[rr, cc, i])
-        yi = np.int32(qy[rr, cc, i])
-        for j in range(i + 1, n):
-            m = ai & np.int32(vv[rr, cc, j])
-            d = abs(xi - np.int32(qx[rr, cc, j])) + abs(yi - np.int32(qy[rr, cc, j]))
-            vd[cc, p] += sign * d * m
-            vm[cc, p] += sign * m
-            p += 1
+@pjit
+def _sample_phase(buf, off, hh, ww, R, C, P, r2max, scl, shift, x0, y0, res, z, samp, box, s):
+    """Every image sampled at the cells of ``samp`` (inside ``box``) on the plane ``z`` into ``s``.
+
+    On a plane the camera coordinates are affine in the column: each row starts
+    from its first cell and steps by ``res`` times the rotation's first column.
+    """
+    n = off.shape[0]
+    for r in prange(box[0], box[1]):
+        Y = y0 - (r + 0.5) * res
+        for i in range(n):
+            p = P[i]
+            dx = x0 - C[i, 0]
+            dy = Y - C[i, 1]
+            dz = z - C[i, 2]
+            bx = R[i, 0, 0] * dx + R[i, 0, 1] * dy + R[i, 0, 2] * dz
+            by = R[i, 1, 0] * dx + R[i, 1, 1] * dy + R[i, 1, 2] * dz
+            bz = R[i, 2, 0] * dx + R[i, 2, 1] * dy + R[i, 2, 2] * dz
+            sx, sy, sz = R[i, 0, 0] * res, R[i, 1, 0] * res, R[i, 2, 0] * res
+            o, h, w = off[i], hh[i], ww[i]
+            sc, su, sv, rmax = scl[i], shift[i, 0], shift[i, 1], r2max[i]
+            for c in range(box[2], box[3]):
+                if samp[r, c] == 0:
+                    continue
+                t = c + 0.5
+                zc = bz + t * sz
+                val = np.float32(np.nan)
+                if zc > 0.0:
+                    xn = (bx + t * sx) / zc
+                    yn = (by + t * sy) / zc
+                    r2 = xn * xn + yn * yn
+                    if r2 <= rmax:
+                        radial = 1.0 + r2 * (p[4] + r2 * (p[5] + r2 * p[6]))
+                        xd = xn * radial + 2.0 * p[7] * xn * yn + p[8] * (r2 + 2.0 * xn * xn)
+                        yd = yn * radial + p[7] * (r2 + 2.0 * yn * yn) + 2.0 * p[8] * xn * yn
+                        u = ((p[0] * xd + p[2]) + 0.5) * sc - 0.5 - su
+                        v = ((p[1] * yd + p[3]) + 0.5) * sc - 0.5 - sv
+                        val = _bilinear(buf, o, h, w, u, v)
+                s[r, c, i] = val
 
 
 @pjit
-def _sweep_plane(
-    buf, off, hh, ww, R, C, P, r2max, scl, shift, inv,
-    x0, y0, res, z, need, samp, win, box, radius, min_valid, best_k,
-    s, qx, qy, vv, a, z0, cost,
-):  # fmt: skip
-    """Cost of plane ``z`` (level ``a``) at the cells with ``need`` into ``cost[r, c, a - z0[r, c]]``.
-
-    ``samp``/``win``: ``need`` dilated by ``radius + 1`` and ``radius`` (uint8),
-    valid inside ``box`` (``r0, r1, c0, c1``: the cells of ``samp``) only.
-    ``s`` (rows, cols, n) float32, ``qx``, ``qy`` int16 and ``vv`` uint8 are
-    work arrays, read only where this call wrote them.
-    """
-    rows, cols = need.shape
-    n = off.shape[0]
-    b0, b1, d0, d1 = box[0], box[1], box[2], box[3]
-    # 1. samples
-    for r in prange(b0, b1):
-        Y = y0 - (r + 0.5) * res
-        for c in range(d0, d1):
-            if samp[r, c] == 0:
-                continue
-            X = x0 + (c + 0.5) * res
-            for i in range(n):
-                s[r, c, i] = _sample_one(
-                    buf,
-                    off[i],
-                    hh[i],
-                    ww[i],
-                    R[i],
-                    C[i],
-                    P[i],
-                    r2max[i],
-                    scl[i],
-                    shift[i, 0],
-                    shift[i, 1],
-                    X,
-                    Y,
-                    z,
-                )
-    # 2. saturated, quantised gradients
-    for r in prange(b0, b1):
-        for c in range(d0, d1):
+def _gradient_phase(s, samp, win, box, inv, qx, qy, vv):
+    """Saturated, quantised gradients at the cells of ``win`` (neighbours read inside ``samp`` only)."""
+    rows, cols, n = s.shape
+    for r in prange(box[0], box[1]):
+        for c in range(box[2], box[3]):
             if win[r, c] == 0:
                 continue
             for i in range(n):
@@ -236,34 +215,66 @@ def _sweep_plane(
                     qx[r, c, i] = _quantise(gx, inv[i, 0])
                     qy[r, c, i] = _quantise(gy, inv[i, 1])
                     vv[r, c, i] = 1
-    # 3. window sums and the multi-image cost
-    npairs = n * (n - 1) // 2
+
+
+@pjit
+def _pair_terms(qx, qy, vv, win, box, pi, pj, td, tm):
+    """Per sample and pair: ``|dqx| + |dqy|`` and 1 where both views are valid (else 0, 0)."""
+    for r in prange(box[0], box[1]):
+        for c in range(box[2], box[3]):
+            if win[r, c] == 0:
+                continue
+            for q in range(pi.shape[0]):
+                i = pi[q]
+                j = pj[q]
+                m = vv[r, c, i] & vv[r, c, j]
+                d = abs(np.int32(qx[r, c, i]) - np.int32(qx[r, c, j])) + abs(
+                    np.int32(qy[r, c, i]) - np.int32(qy[r, c, j])
+                )
+                td[r, c, q] = np.int16(d * m)
+                tm[r, c, q] = m
+
+
+@njit
+def _add_sample(td, tm, vv, rr, cc, sign, vd, vm, vc):
+    """Adds (sign +1) or removes (-1) sample (rr, cc) to the column sums of every term and view."""
+    for q in range(td.shape[2]):
+        vd[cc, q] += sign * np.int32(td[rr, cc, q])
+        vm[cc, q] += sign * np.int32(tm[rr, cc, q])
+    for i in range(vv.shape[2]):
+        vc[cc, i] += sign * np.int32(vv[rr, cc, i])
+
+
+@pjit
+def _window_cost(td, tm, vv, need, win, box, radius, min_valid, best_k, pi, pj, a, z0, cost):
+    """Window sums of the pair terms at the cells with ``need``, and the multi-image cost from them
+    (mean of the best pairs, as :func:`~truortho.core.sgm.multi_image_cost`) into
+    ``cost[r, c, a - z0[r, c]]``."""
+    rows, cols, nt = td.shape
+    n = vv.shape[2]
+    b0, b1, d0, d1 = box[0], box[1], box[2], box[3]
     nstrips = (b1 - b0 + STRIP - 1) // STRIP
     cmax = np.float64(COST_MAX)
     scale = 1.0 / (2.0 * _GQ)
     for st in prange(nstrips):
         r0 = b0 + st * STRIP
         r1 = min(b1, r0 + STRIP)
-        vd = np.zeros((cols, max(1, npairs)), np.int32)
-        vm = np.zeros((cols, max(1, npairs)), np.int32)
+        vd = np.zeros((cols, nt), np.int32)
+        vm = np.zeros((cols, nt), np.int32)
         vc = np.zeros((cols, n), np.int32)
         last = np.full(cols, -10, np.int64)  # row whose column sums vd/vm/vc hold
-        hd = np.zeros(max(1, npairs), np.int32)
-        hm = np.zeros(max(1, npairs), np.int32)
+        hd = np.zeros(nt, np.int32)
+        hm = np.zeros(nt, np.int32)
         hc = np.zeros(n, np.int32)
-        col = np.empty(max(1, npairs), np.float32)
-        kbuf = np.empty(max(1, npairs), np.float32)
+        col = np.empty(nt, np.float32)
+        kbuf = np.empty(nt, np.float32)
         for r in range(r0, r1):
-            rlo = max(0, r - radius)
-            rhi = min(rows, r + radius + 1)
             # column sums at every column within `radius` of a searching cell of this row
             for cc in range(d0, d1):
                 if win[r, cc] == 0:
                     continue
-                lo = max(0, cc - radius)
-                hi = min(cols, cc + radius + 1)
                 used = False
-                for c in range(lo, hi):
+                for c in range(max(0, cc - radius), min(cols, cc + radius + 1)):
                     if need[r, c]:
                         used = True
                         break
@@ -271,42 +282,42 @@ def _sweep_plane(
                     continue
                 if last[cc] == r - 1:
                     if r + radius < rows:
-                        _add_row(qx, qy, vv, r + radius, cc, n, 1, vd, vm, vc)
+                        _add_sample(td, tm, vv, r + radius, cc, 1, vd, vm, vc)
                     if r - radius - 1 >= 0:
-                        _add_row(qx, qy, vv, r - radius - 1, cc, n, -1, vd, vm, vc)
+                        _add_sample(td, tm, vv, r - radius - 1, cc, -1, vd, vm, vc)
                 else:
                     vd[cc, :] = 0
                     vm[cc, :] = 0
                     vc[cc, :] = 0
-                    for rr in range(rlo, rhi):
-                        _add_row(qx, qy, vv, rr, cc, n, 1, vd, vm, vc)
+                    for rr in range(max(0, r - radius), min(rows, r + radius + 1)):
+                        _add_sample(td, tm, vv, rr, cc, 1, vd, vm, vc)
                 last[cc] = r
             # window sums along runs of searching cells
             prev = -10
             for c in range(d0, d1):
                 if need[r, c] == 0:
                     continue
-                lo = max(0, c - radius)
-                hi = min(cols, c + radius + 1)
                 if prev == c - 1:
                     if c + radius < cols:
-                        for q in range(npairs):
-                            hd[q] += vd[c + radius, q]
-                            hm[q] += vm[c + radius, q]
+                        ca = c + radius
+                        for q in range(nt):
+                            hd[q] += vd[ca, q]
+                            hm[q] += vm[ca, q]
                         for i in range(n):
-                            hc[i] += vc[c + radius, i]
+                            hc[i] += vc[ca, i]
                     if c - radius - 1 >= 0:
-                        for q in range(npairs):
-                            hd[q] -= vd[c - radius - 1, q]
-                            hm[q] -= vm[c - radius - 1, q]
+                        cs = c - radius - 1
+                        for q in range(nt):
+                            hd[q] -= vd[cs, q]
+                            hm[q] -= vm[cs, q]
                         for i in range(n):
-                            hc[i] -= vc[c - radius - 1, i]
+                            hc[i] -= vc[cs, i]
                 else:
                     hd[:] = 0
                     hm[:] = 0
                     hc[:] = 0
-                    for cc in range(lo, hi):
-                        for q in range(npairs):
+                    for cc in range(max(0, c - radius), min(cols, c + radius + 1)):
+                        for q in range(nt):
                             hd[q] += vd[cc, q]
                             hm[q] += vm[cc, q]
                         for i in range(n):
@@ -321,15 +332,10 @@ def _sweep_plane(
                 if nv < 2:
                     cost[r, c, kk] = COST_MAX
                     continue
-                q = 0
-                for i in range(n):
-                    for j in range(i + 1, n):
-                        if hc[i] >= k and hc[j] >= k and hm[q] >= k:
-                            col[q] = min(1.0, hd[q] * scale / hm[q])
-                        else:
-                            col[q] = np.nan
-                        q += 1
-                m = _combine(col, npairs, nv, best_k, kbuf)
+                for q in range(nt):
+                    ok = hc[pi[q]] >= k and hc[pj[q]] >= k and hm[q] >= k
+                    col[q] = min(1.0, hd[q] * scale / hm[q]) if ok else np.nan
+                m = _combine(col, nt, nv, best_k, kbuf)
                 if m < 0.0:
                     cost[r, c, kk] = COST_MAX
                 else:
@@ -393,10 +399,16 @@ class PlaneSweep:
         self.min_valid = float(min_valid)
         sc = np.asarray(scales, np.float64)
         self.inv = np.ascontiguousarray(np.where(sc > 0.0, _GQ / np.where(sc > 0.0, sc, 1.0), 0.0))
+        pi, pj = np.triu_indices(n, 1)
+        self.pi = pi.astype(np.int64)
+        self.pj = pj.astype(np.int64)
+        nt = len(self.pi)
         self.s = np.empty((rows, cols, n), np.float32)
         self.qx = np.empty((rows, cols, n), np.int16)
         self.qy = np.empty((rows, cols, n), np.int16)
         self.vv = np.empty((rows, cols, n), np.uint8)
+        self.td = np.empty((rows, cols, max(1, nt)), np.int16)
+        self.tm = np.empty((rows, cols, max(1, nt)), np.uint8)
         self.tmp = np.empty((rows, cols), np.uint8)
         self.samp = np.empty((rows, cols), np.uint8)
         self.win = np.empty((rows, cols), np.uint8)
@@ -412,9 +424,13 @@ class PlaneSweep:
         _dilate(need8, self.radius + 1, box, self.tmp, self.samp)
         _dilate(need8, self.radius, box, self.tmp, self.win)
         p = self.pack
-        _sweep_plane(
-            p.buf, p.off, p.hh, p.ww, p.R, p.C, p.P, p.r2max, p.scale, p.shift, self.inv,
-            float(x0), float(y0), float(res), float(z), need8, self.samp, self.win, box,
-            self.radius, self.min_valid, int(best_k or 0),
-            self.s, self.qx, self.qy, self.vv, int(a), z0, cost,
+        _sample_phase(
+            p.buf, p.off, p.hh, p.ww, p.R, p.C, p.P, p.r2max, p.scale, p.shift,
+            float(x0), float(y0), float(res), float(z), self.samp, box, self.s,
+        )  # fmt: skip
+        _gradient_phase(self.s, self.samp, self.win, box, self.inv, self.qx, self.qy, self.vv)
+        _pair_terms(self.qx, self.qy, self.vv, self.win, box, self.pi, self.pj, self.td, self.tm)
+        _window_cost(
+            self.td, self.tm, self.vv, need8, self.win, box, self.radius, self.min_valid, int(best_k or 0),
+            self.pi, self.pj, int(a), z0, cost,
         )  # fmt: skip

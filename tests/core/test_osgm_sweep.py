@@ -144,10 +144,11 @@ def test_sweep_kernels_without_the_jit():
     sw._dilate.py_func(need8, 1, box, p.tmp, p.win)
     got = np.full((rows, cols, 1), 9999, np.uint16)
     k = p.pack
-    sw._sweep_plane.py_func(
-        k.buf, k.off, k.hh, k.ww, k.R, k.C, k.P, k.r2max, k.scale, k.shift, p.inv,
-        0.0, 0.0, RES, Z, need8, p.samp, p.win, box, 1, 0.5, 0,
-        p.s, p.qx, p.qy, p.vv, 0, z0, got,
-    )  # fmt: skip
+    sw._sample_phase.py_func(
+        k.buf, k.off, k.hh, k.ww, k.R, k.C, k.P, k.r2max, k.scale, k.shift, 0.0, 0.0, RES, Z, p.samp, box, p.s
+    )
+    sw._gradient_phase.py_func(p.s, p.samp, p.win, box, p.inv, p.qx, p.qy, p.vv)
+    sw._pair_terms.py_func(p.qx, p.qy, p.vv, p.win, box, p.pi, p.pj, p.td, p.tm)
+    sw._window_cost.py_func(p.td, p.tm, p.vv, need8, p.win, box, 1, 0.5, 0, p.pi, p.pj, 0, z0, got)
     assert np.array_equal(got, want)
     assert np.all(got[need] < 9999) and np.all(got[~need] == 9999)
