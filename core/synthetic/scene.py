@@ -273,13 +273,19 @@ def _write_geotiff(path: Path, bands: np.ndarray, gt, crs: str, nodata) -> None:
             tmp.unlink()
 
 
-def make_scene(config: SceneConfig | None = None, progress: Progress | None = None) -> SyntheticScene:
+def make_scene(
+    config: SceneConfig | None = None, progress: Progress | None = None, image_sink=None
+) -> SyntheticScene:
     """Build, render and control a synthetic block (deterministic in ``config``).
 
     Nadir block over ``config.extent`` (:func:`~.cameras.nadir_block`), then
     ``config.n_oblique`` obliques aimed at the extent centre; images are
     rendered with occlusion and per-image radiometry; GCPs are chosen and
     observed (:func:`~.truth.select_gcps`).
+
+    ``image_sink(index, image, rgb)``: when given, every rendered image is
+    handed to it and not kept (``scene.images`` stays empty), so that blocks
+    of hundreds of large images are rendered in bounded memory.
     """
     cfg = config if config is not None else SceneConfig()
     if not isinstance(cfg, SceneConfig):
@@ -317,7 +323,11 @@ def make_scene(config: SceneConfig | None = None, progress: Progress | None = No
         rad = random_radiometry(rng, cfg.gain_sigma, cfg.offset_sigma, cfg.vignetting, cfg.noise_sigma,
                                 cfg.seed * 1000 + k)
         scene.radiometry.append(rad)
-        scene.images.append(jpeg_roundtrip(apply_radiometry(colour, cam, rad), cfg.jpeg_quality))
+        rgb = jpeg_roundtrip(apply_radiometry(colour, cam, rad), cfg.jpeg_quality)
+        if image_sink is None:
+            scene.images.append(rgb)
+        else:
+            image_sink(k, im, rgb)
         progress.update(0.95 * (k + 1) / len(images), f"rendered {im.name}")
     scene.render_seconds = time.perf_counter() - t0
     orientation.gcps = truth.select_gcps(surface, images, cam, cfg.offset, cfg.n_gcps, cfg.gcp_on_roof,

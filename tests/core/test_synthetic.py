@@ -52,6 +52,17 @@ def test_determinism():
     assert not np.array_equal(a.images[0], c.images[0])
 
 
+def test_image_sink_receives_the_same_images_and_keeps_none():
+    a = make_scene(_small(noise_sigma=2.0))
+    got = {}
+    b = make_scene(_small(noise_sigma=2.0), image_sink=lambda k, im, rgb: got.__setitem__(k, (im.name, rgb)))
+    assert b.images == [] and sorted(got) == list(range(len(a.images)))
+    for k, x in enumerate(a.images):
+        assert got[k][0] == a.orientation.images[k].name
+        assert np.array_equal(got[k][1], x)
+    assert a.orientation.to_dict() == b.orientation.to_dict()
+
+
 def test_block_layout(scene):
     o = scene.orientation
     assert o.crs == "EPSG:32632"

@@ -1,0 +1,354 @@
+"""Scale bench (issue 18): synthetic blocks of N photos with GNSS in EXIF, end to end through QGIS.
+
+::
+
+    make bench BENCH=scale                                       # 50, 100, 200, 400 photos of 12 MP
+    make bench BENCH=scale BENCH_ARGS="--sizes 20,50 --megapixels 3 --write-docs"
+
+For every size N the bench renders a synthetic nadir block of about N photos
+(:func:`block_config`: a square area at 75/60 % overlap from 100 m, buildings
+at a constant density, terrain relief), one image at a time straight to a
+JPEG carrying its **noisy GNSS position in EXIF** (2 to 5 m, drawn per block)
+and the focal length with the sensor size, so nothing but the photos and a few
+GCPs go in (``gcp_list.txt`` -> ``truortho:importgcps``, a quarter of them check
+points). Then it runs ``truortho:pipeline`` through ``qgis_process`` with its
+defaults and reads the stages' wall time and peak memory from the products'
+``report.json``. It prints one row per block and stage, the time per photo,
+and the growth of the time per photo from the smallest to the largest block,
+and writes a DSM hillshade beside the true ortho per block to
+``bench/results/scale/block_N.jpg``.
+
+Rendering is not timed as part of the pipeline (it is printed apart). The
+blocks are deleted after each run unless ``--keep`` is given. With
+``--write-docs`` the table goes into ``docs/benchmarks.md`` between the
+``scale`` markers, with the command, the commit and the machine.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+QP = os.path.join(ROOT, "scripts", "qgis_process")
+DOCS = os.path.join(ROOT, "docs", "benchmarks.md")
+#: Sensor width of the simulated camera (a 1" sensor), millimetres.
+SENSOR_WIDTH_MM = 13.2
+#: Flying height above ground, metres (the GSD follows from the image size: about 3 cm at 12 MP).
+FLYING_HEIGHT = 100.0
+#: Buildings per square metre of block.
+BUILDING_DENSITY = 1.0 / 700.0
+
+
+def image_size(megapixels: float) -> tuple[int, int]:
+    """A 4:3 image of about ``megapixels`` (width and height multiples of 8)."""
+    w = int(round(math.sqrt(megapixels * 1e6 * 4.0 / 3.0) / 8.0)) * 8
+    return w, (w * 3 // 4) // 8 * 8
+
+
+def _count(side: float, w: int, h: int, focal: float, height: float, fwd: float, side_ov: float) -> int:
+    gsd = height / focal
+    along, across = h * gsd, w * gsd
+    n_along = max(3, math.ceil(max(side - along, 0) / ((1 - fwd) * along) - 1e-9) + 1)
+    n_strips = max(2, math.ceil(max(side - across, 0) / ((1 - side_ov) * across) - 1e-9) + 1)
+    return n_along * n_strips
+
+
+def block_config(n_images: int, megapixels: float, seed: int):
+    """The :class:`~truortho.core.synthetic.SceneConfig` of a square nadir block of about ``n_images``."""
+    from truortho.core.synthetic import SceneConfig
+
+    w, h = image_size(megapixels)
+    focal = 0.8 * w
+    height = FLYING_HEIGHT
+    fwd, side_ov = 0.75, 0.6
+    lo, hi = 1.0, 1e5
+    for _ in range(60):  # the smallest square side whose block has at least n_images photos
+        mid = 0.5 * (lo + hi)
+        if _count(mid, w, h, focal, height, fwd, side_ov) >= n_images:
+            hi = mid
+        else:
+            lo = mid
+    side = hi
+    half = side / 2
+    cfg = SceneConfig(
+        extent=(-half, -half, half, half),
+        n_buildings=max(1, int(round(BUILDING_DENSITY * side * side))),
+        building_size=(8.0, 20.0),
+        eave_height=(4.0, 14.0),
+        building_gap=4.0,
+        tower=False,
+        terrain_relief=4.0,
+        image_size=(w, h),
+        focal_px=focal,
+        flying_height=height,
+        forward_overlap=fwd,
+        side_overlap=side_ov,
+        n_oblique=0,
+        jpeg_quality=0,  # encoded once, by the sink, with EXIF
+        supersample=1,
+        adaptive_supersampling=True,
+        n_gcps=8,
+        check_fraction=0.25,
+        grid_margin=max(300.0, side),
+        seed=seed,
+    )
+    return _placeable(cfg)
+
+
+def _placeable(cfg):
+    """``cfg`` with as many of its buildings as the generator can place (small blocks hold fewer)."""
+    import dataclasses
+
+    from truortho.core.errors import InputError
+    from truortho.core.synthetic.surface import Surface
+
+    while True:
+        try:
+            Surface(cfg)
+            return cfg
+        except InputError:
+            if cfg.n_buildings <= 1:
+                raise
+            cfg = dataclasses.replace(cfg, n_buildings=cfg.n_buildings - 1)
+
+
+def _rational(x: float, den: int = 10000) -> tuple[int, int]:
+    return int(round(x * den)), den
+
+
+def _dms(deg: float):
+    deg = abs(deg)
+    d = int(deg)
+    m = int((deg - d) * 60)
+    s = (deg - d - m / 60) * 3600
+    return (_rational(d, 1), _rational(m, 1), _rational(s, 10000))
+
+
+def jpeg_with_gnss(path: str, rgb: np.ndarray, lat: float, lon: float, alt: float, focal_px: float,
+                   quality: int = 90) -> None:  # fmt: skip
+    """Write an RGB uint8 image as JPEG with the GNSS position, focal length and sensor size in EXIF."""
+    from PIL import Image as PILImage
+    from PIL import TiffImagePlugin
+
+    h, w = rgb.shape[:2]
+    R = TiffImagePlugin.IFDRational
+    ex = PILImage.Exif()
+    ex[0x010F] = "TruOrtho"
+    ex[0x0110] = "synthetic 1in"
+    ex[0x8769] = {
+        0x920A: R(*_rational(focal_px * SENSOR_WIDTH_MM / w)),
+        0xA002: w,
+        0xA003: h,
+        0xA20E: R(*_rational(w / SENSOR_WIDTH_MM)),
+        0xA20F: R(*_rational(w / SENSOR_WIDTH_MM)),
+        0xA210: 4,  # millimetres
+    }
+    ex[0x8825] = {
+        0: b"\x02\x03\x00\x00",
+        1: "N" if lat >= 0 else "S",
+        2: tuple(R(*v) for v in _dms(lat)),
+        3: "E" if lon >= 0 else "W",
+        4: tuple(R(*v) for v in _dms(lon)),
+        5: b"\x00",
+        6: R(*_rational(alt, 100)),
+    }
+    tmp = path + ".part"
+    PILImage.fromarray(rgb).save(tmp, "JPEG", quality=quality, exif=ex.tobytes())
+    os.replace(tmp, path)
+
+
+def render_block(n_images: int, megapixels: float, seed: int, folder: str, log) -> dict:
+    """Render the block into ``folder/images`` (JPEG + EXIF GNSS) and ``folder/gcp_list.txt``."""
+    from pyproj import Transformer
+
+    from truortho.core.synthetic import make_scene
+
+    cfg = block_config(n_images, megapixels, seed)
+    images = os.path.join(folder, "images")
+    os.makedirs(images, exist_ok=True)
+    rng = np.random.default_rng([seed, 181])
+    sigma = float(rng.uniform(2.0, 5.0))
+    to_wgs = Transformer.from_crs(cfg.crs, "EPSG:4326", always_xy=True)
+    off = np.asarray(cfg.offset, float)
+    names = {}
+    t = time.perf_counter()
+
+    def sink(k, im, rgb):
+        C = im.C + off + rng.normal(0.0, sigma, 3)
+        lon, lat = to_wgs.transform(C[0], C[1])
+        name = os.path.splitext(im.name)[0] + ".jpg"
+        names[im.name] = name
+        jpeg_with_gnss(os.path.join(images, name), rgb, lat, lon, float(C[2]), cfg.focal_px)
+        if (k + 1) % 25 == 0:
+            log(f"    rendered {k + 1} photos ({time.perf_counter() - t:.0f} s)")
+
+    scene = make_scene(cfg, image_sink=sink)
+    lines = [cfg.crs]
+    for g in scene.orientation.gcps:
+        for name, u, v in g.observations:
+            lines.append(
+                f"{g.xyz[0]:.4f} {g.xyz[1]:.4f} {g.xyz[2]:.4f} {u:.3f} {v:.3f} {names[name]} {g.name}"
+            )
+    with open(os.path.join(folder, "gcp_list.txt"), "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    checks = [g.name for g in scene.orientation.gcps if g.role == "check"]
+    w, h = cfg.image_size
+    return {
+        "photos": len(scene.orientation.images),
+        "megapixels": round(w * h / 1e6, 1),
+        "area_m": round(cfg.extent[2] - cfg.extent[0], 1),
+        "gnss_sigma_m": round(sigma, 2),
+        "gcps": len(scene.orientation.gcps),
+        "checks": checks,
+        "render_s": round(time.perf_counter() - t, 1),
+    }
+
+
+def run_pipeline(folder: str, checks: list[str], resolution: float, log) -> dict:
+    gcps = os.path.join(folder, "gcp_list.txt")
+    imp = [QP, "run", "truortho:importgcps", "--", f"INPUT={gcps}", f"GCPS={folder}/gcps.gpkg",
+           f"OBSERVATIONS={folder}/obs.gpkg"]  # fmt: skip
+    if checks:
+        imp.append(f"CHECK_POINTS={','.join(checks)}")
+    p = subprocess.run(imp, capture_output=True, text=True)
+    if p.returncode:
+        raise SystemExit(f"importgcps failed:\n{p.stdout[-1500:]}\n{p.stderr[-1500:]}")
+    products = os.path.join(folder, "products")
+    args = [f"IMAGES={folder}/images", f"GCPS={folder}/gcps.gpkg", f"OBSERVATIONS={folder}/obs.gpkg",
+            f"RESOLUTION={resolution}", f"OUTPUT_FOLDER={products}"]  # fmt: skip
+    t = time.perf_counter()
+    p = subprocess.run([QP, "run", "truortho:pipeline", "--", *args], capture_output=True, text=True)
+    wall = time.perf_counter() - t
+    with open(os.path.join(folder, "pipeline.log"), "w") as fh:
+        fh.write(p.stdout + p.stderr)
+    if p.returncode:
+        raise SystemExit(f"the pipeline failed (see {folder}/pipeline.log):\n{p.stderr[-2000:]}")
+    sys.path.insert(0, HERE)
+    from real_blocks import picture
+
+    picture(products, os.path.join(HERE, "results", "scale", f"{os.path.basename(folder)}.jpg"))
+    with open(os.path.join(products, "report.json")) as fh:
+        rep = json.load(fh)
+    stages = next(t["rows"] for t in rep["tables"] if t["title"] == "Stages")
+    return {
+        "wall_s": round(wall, 1),
+        "stages": [[r[0], r[1], r[2]] for r in stages],
+        "summary": rep["summary"],
+    }
+
+
+def table(rows: list[dict]) -> list[str]:
+    names: list[str] = []
+    for r in rows:
+        for s in r["run"]["stages"]:
+            if s[0] not in names:
+                names.append(s[0])
+    head = (
+        "| photos | MP | area [m] | render [s] | pipeline [s] | s / photo | peak [MB] | "
+        + " | ".join(f"{n} [s]" for n in names)
+        + " |"
+    )
+    out = [head, "|" + "---|" * (7 + len(names))]
+    for r in rows:
+        st = {s[0]: s for s in r["run"]["stages"]}
+        wall = r["run"]["wall_s"]
+        peak = max((s[2] for s in r["run"]["stages"] if s[2] is not None), default=float("nan"))
+        cells = [str(r["photos"]), f"{r['megapixels']:.1f}", f"{r['area_m']:.0f}", f"{r['render_s']:.0f}",
+                 f"{wall:.0f}", f"{wall / r['photos']:.2f}", f"{peak:.0f}"]  # fmt: skip
+        cells += [f"{st[n][1]:.0f}" if n in st else "" for n in names]
+        out.append("| " + " | ".join(cells) + " |")
+    if len(rows) >= 2:
+        a, b = rows[0], rows[-1]
+        g = (b["run"]["wall_s"] / b["photos"]) / (a["run"]["wall_s"] / a["photos"])
+        out.append("")
+        out.append(
+            f"Time per photo from {a['photos']} to {b['photos']} photos: x{g:.2f} "
+            "(goal <= 1.5 from 100 to 400)."
+        )
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--sizes", default="50,100,200,400", help="comma-separated photo counts")
+    ap.add_argument("--megapixels", type=float, default=12.0)
+    ap.add_argument("--resolution", type=float, default=0.0, help="RESOLUTION of the pipeline (0 = the GSD)")
+    ap.add_argument("--seed", type=int, default=2026)
+    ap.add_argument("--keep", default="", help="keep the blocks and products in this folder")
+    ap.add_argument("--write-docs", action="store_true", help=f"update the scale section of {DOCS}")
+    args = ap.parse_args(argv)
+    sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
+    if not sizes or min(sizes) < 6:
+        raise SystemExit("--sizes: expected photo counts of at least 6")
+
+    def log(msg: str) -> None:
+        print(msg, flush=True)
+
+    rows = []
+    base = args.keep or tempfile.mkdtemp(prefix="truortho-scale-")
+    try:
+        for n in sizes:
+            folder = os.path.join(base, f"block_{n}")
+            log(f"block of {n} photos at {args.megapixels} MP:")
+            info = render_block(n, args.megapixels, args.seed, folder, log)
+            log(
+                f"  {info['photos']} photos rendered in {info['render_s']} s; "
+                f"GNSS sigma {info['gnss_sigma_m']} m"
+            )
+            info["run"] = run_pipeline(folder, info["checks"], args.resolution, log)
+            for s in info["run"]["stages"]:
+                log(f"  {s[0]:<24} {s[1]:>8.1f} s  peak {s[2]} MB")
+            log(
+                f"  pipeline {info['run']['wall_s']} s "
+                f"({info['run']['wall_s'] / info['photos']:.2f} s per photo)"
+            )
+            rows.append(info)
+            if not args.keep:
+                shutil.rmtree(folder, ignore_errors=True)
+    finally:
+        if not args.keep:
+            shutil.rmtree(base, ignore_errors=True)
+    lines = table(rows)
+    print("\n".join(lines))
+    os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
+    with open(os.path.join(HERE, "results", "scale.json"), "w") as fh:
+        json.dump(rows, fh, indent=1)
+    if args.write_docs:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                                text=True).stdout.strip()  # fmt: skip
+        cmd = 'make bench BENCH=scale BENCH_ARGS="' + " ".join(sys.argv[1:]) + '"'
+        block = [f"Command: `{cmd}` at commit {commit}, {time.strftime('%Y-%m-%d')}, "
+                 f"{os.cpu_count()} cores, {platform.machine()}.", ""] + lines  # fmt: skip
+        write_section(DOCS, "scale", block)
+    return 0
+
+
+def write_section(path: str, key: str, lines: list[str]) -> None:
+    """Replace the text between ``<!-- key:begin -->`` and ``<!-- key:end -->`` (appended when missing)."""
+    begin, end = f"<!-- {key}:begin -->", f"<!-- {key}:end -->"
+    text = open(path).read() if os.path.exists(path) else "# Benchmarks\n"
+    body = "\n".join([begin, *lines, end])
+    if begin in text and end in text:
+        text = text[: text.index(begin)] + body + text[text.index(end) + len(end) :]
+    else:
+        text = text.rstrip("\n") + "\n\n## Scale: photos to true ortho\n\n" + body + "\n"
+    tmp = path + ".part"
+    with open(tmp, "w") as fh:
+        fh.write(text)
+    os.replace(tmp, path)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
