@@ -14,7 +14,8 @@ sub-ranges so nested stages report a monotonic overall fraction.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import time
+from collections.abc import Callable, Sequence
 from typing import Protocol, runtime_checkable
 
 from .errors import CancelledError
@@ -84,6 +85,61 @@ class Steps:
 
     def __len__(self) -> int:
         return len(self.edges) - 1
+
+
+def format_duration(seconds: float) -> str:
+    """``"45 s"``, ``"12 min"``, ``"2 h 05 min"`` (rounded to what a user plans with)."""
+    s = max(0.0, float(seconds))
+    if s < 90:
+        return f"{s:.0f} s"
+    m = int(round(s / 60.0))
+    if m < 120:
+        return f"{m} min"
+    return f"{m // 60} h {m % 60:02d} min"
+
+
+class EtaProgress:
+    """Adds the elapsed time and an estimate of the time left to the messages of one long task.
+
+    The clock starts at the first report (stages made up front start when they start). The
+    estimate is ``elapsed (1 - f) / f`` from the task's own completed fraction ``f`` (rounded
+    by :func:`format_duration`); it appears once the task has run ``min_seconds`` and done
+    ``min_fraction``, so the first, unrepresentative seconds do not produce wild figures.
+    """
+
+    def __init__(
+        self,
+        parent: Progress | None,
+        min_seconds: float = 10.0,
+        min_fraction: float = 0.02,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.parent = as_progress(parent)
+        self.min_seconds = float(min_seconds)
+        self.min_fraction = float(min_fraction)
+        self.clock = clock
+        self.t0: float | None = None
+
+    def annotate(self, fraction: float, message: str | None) -> str | None:
+        """``message`` with the elapsed time and the estimate appended (when due)."""
+        f = min(max(float(fraction), 0.0), 1.0)
+        now = self.clock()
+        if self.t0 is None:
+            self.t0 = now
+        if message:
+            elapsed = now - self.t0
+            if elapsed >= self.min_seconds and self.min_fraction <= f < 1.0:
+                left = elapsed * (1.0 - f) / f
+                eta = f"{format_duration(elapsed)} elapsed, about {format_duration(left)} left"
+                message = f"{message} ({eta})"
+        return message
+
+    def update(self, fraction: float, message: str | None = None) -> None:
+        message = self.annotate(fraction, message)
+        self.parent.update(min(max(float(fraction), 0.0), 1.0), message)
+
+    def cancelled(self) -> bool:
+        return self.parent.cancelled()
 
 
 def as_progress(progress: Progress | None) -> Progress:

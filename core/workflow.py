@@ -39,7 +39,7 @@ import numpy as np
 
 from .errors import InputError
 from .memory import peak_rss_mb
-from .progress import Progress, Steps, as_progress, check
+from .progress import EtaProgress, Progress, Steps, as_progress, check
 from .report import Report, Table
 
 #: Product names in the output folder.
@@ -202,7 +202,10 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
     folder.mkdir(parents=True, exist_ok=True)
     paths = _paths(folder)
     progress = as_progress(progress)
-    steps = Steps(progress, [0.35, 0.35, 0.04, 0.06, 0.18, 0.02])
+    weights = [0.35, 0.35, 0.04, 0.06, 0.18, 0.02]
+    stage_steps = Steps(progress, weights)
+    # every stage's messages carry its elapsed time and an estimate of its time left
+    steps = [EtaProgress(stage_steps[k]) for k in range(len(weights))]
     stages = _Stages()
     report = Report("TruOrtho pipeline report")
     t0 = time.perf_counter()

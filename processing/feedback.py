@@ -13,15 +13,21 @@ import contextlib
 from qgis.core import QgsProcessingException
 
 from ..core.errors import CancelledError, TruOrthoError
+from ..core.progress import EtaProgress
 from .i18n import tr
 
 
 class FeedbackProgress:
-    """Core ``Progress`` backed by a ``QgsProcessingFeedback`` (or None)."""
+    """Core ``Progress`` backed by a ``QgsProcessingFeedback`` (or None).
 
-    def __init__(self, feedback) -> None:
+    ``eta``: append the elapsed time and an estimate of the time left to the messages
+    (:class:`~truortho.core.progress.EtaProgress`; off where the core does it per stage).
+    """
+
+    def __init__(self, feedback, eta: bool = True) -> None:
         self.feedback = feedback
         self._last_message: str | None = None
+        self._eta = EtaProgress(None) if eta else None
 
     def update(self, fraction: float, message: str | None = None) -> None:
         if self.feedback is None:
@@ -29,8 +35,8 @@ class FeedbackProgress:
         f = min(max(float(fraction), 0.0), 1.0)
         self.feedback.setProgress(100.0 * f)
         if message and message != self._last_message:
-            self.feedback.pushInfo(message)
             self._last_message = message
+            self.feedback.pushInfo(self._eta.annotate(f, message) if self._eta is not None else message)
 
     def cancelled(self) -> bool:
         return bool(self.feedback is not None and self.feedback.isCanceled())

@@ -146,7 +146,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
             gcps,
             crs_text(crs) if crs.isValid() else None,
             cfg,
-            FeedbackProgress(feedback),
+            FeedbackProgress(feedback, eta=False),  # the workflow estimates per stage
         )
         for row in run.stats["stages"]:
             feedback.pushInfo(tr("{}: {:.1f} s, peak {:.0f} MB; {}").format(row[0], row[1], row[2], row[3]))

@@ -40,6 +40,22 @@ def test_feedback_progress_implements_core_protocol():
     assert p.cancelled()
 
 
+def test_feedback_progress_appends_an_estimate_of_the_time_left():
+    from truortho.processing.feedback import FeedbackProgress
+
+    now = [0.0]
+    fb = RecordingFeedback()
+    p = FeedbackProgress(fb)
+    p._eta.clock = lambda: now[0]
+    p.update(0.0, "tile 1/4")
+    now[0] = 20.0
+    p.update(0.25, "tile 2/4")
+    assert fb.infos == ["tile 1/4", "tile 2/4 (20 s elapsed, about 60 s left)"]
+    q = FeedbackProgress(RecordingFeedback(), eta=False)  # the pipeline: the workflow does it per stage
+    q.update(0.5, "x")
+    assert q.feedback.infos == ["x"]
+
+
 def test_feedback_progress_with_real_feedback(qgis_processing_ready):
     from qgis.core import QgsProcessingFeedback
 
