@@ -262,7 +262,7 @@ class SceneConfig:
                 bad(name, f"must lie in [{lo}, {hi}]")
         if self.coarse_cell < self.fine_step:
             bad("coarse_cell", "must not be smaller than fine_step")
-        for name, lo, hi in (("n_buildings", 0, 100), ("texture_octaves", 1, 12), ("n_oblique", 0, 8),
+        for name, lo, hi in (("n_buildings", 0, 2000), ("texture_octaves", 1, 12), ("n_oblique", 0, 8),
                              ("supersample", 1, 6), ("n_gcps", 0, 1000), ("min_gcp_views", 1, 1000),
                              ("jpeg_quality", 0, 100),
                              ("seed", 0, 2**31 - 1)):
