@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..imagery import luminance, read_image, resample, scaled_size, to_uint8
-from ..progress import Progress, as_progress, check
+from ..progress import Progress, as_progress
 
 _CACHE_VERSION = 2
 #: Position bias of cv2.SIFT keypoints, working-resolution pixels (see the module docstring).
@@ -245,8 +245,13 @@ def extract_all(
     config: FeatureConfig | None = None,
     cache_dir=None,
     progress: Progress | None = None,
+    threads: int | None = None,
 ) -> tuple[list[Features], dict]:
     """Features of several images, with progress and cancellation per image.
+
+    ``threads``: images extracted at once (default
+    :func:`~truortho.core.parallel.threads.default_threads`); the features do not
+    depend on it.
 
     Returns
     -------
@@ -256,22 +261,31 @@ def extract_all(
         ``seconds`` (total), ``seconds_per_image`` (list), ``cached`` (count of
         images read from the cache), ``n_features`` (list).
     """
+    from ..parallel.threads import thread_map
+
     cfg = config or FeatureConfig()
     cfg.validate()
     prog = as_progress(progress)
     paths = [os.fspath(p) for p in paths]
     out: list[Features] = []
     times: list[float] = []
-    cached = 0
+    cached = sum(
+        1
+        for p in paths
+        if cache_dir is not None and os.path.isfile(p) and os.path.isfile(cache_path(p, cache_dir, cfg))
+    )
     t0 = time.perf_counter()
-    for k, p in enumerate(paths):
-        check(prog)
-        prog.update(k / max(len(paths), 1), f"features of {os.path.basename(p)}")
+
+    def one(p):
         t = time.perf_counter()
-        if cache_dir is not None and os.path.isfile(p) and os.path.isfile(cache_path(p, cache_dir, cfg)):
-            cached += 1
-        out.append(extract_features(p, cfg, cache_dir))
-        times.append(time.perf_counter() - t)
+        return extract_features(p, cfg, cache_dir), time.perf_counter() - t
+
+    def message(k, n):
+        return f"features of {os.path.basename(paths[k])}"
+
+    for f, dt in thread_map(one, paths, threads, prog, message):
+        out.append(f)
+        times.append(dt)
     prog.update(1.0, f"features of {len(paths)} images")
     stats = {
         "seconds": time.perf_counter() - t0,

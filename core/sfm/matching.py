@@ -20,7 +20,7 @@ import numpy as np
 from ..errors import InputError
 from ..geometry.camera import Camera
 from ..jit import fastjit
-from ..progress import Progress, as_progress, check
+from ..progress import Progress, as_progress
 from .features import Features
 from .twoview import TwoViewConfig, TwoViewResult, estimate_two_view
 
@@ -231,8 +231,12 @@ def match_pairs(
     match_config: MatchConfig | None = None,
     twoview_config: TwoViewConfig | None = None,
     progress: Progress | None = None,
+    threads: int | None = None,
 ) -> tuple[list[PairMatches], dict]:
     """Match and geometrically verify image pairs.
+
+    Pairs are matched ``threads`` at a time (default
+    :func:`~truortho.core.parallel.threads.default_threads`); the results do not depend on it.
 
     Parameters
     ----------
@@ -266,12 +270,14 @@ def match_pairs(
         raise InputError(f"match_pairs: pairs must be distinct image indices in [0, {n})")
     if cameras is not None and len(cameras) != n:
         raise InputError(f"match_pairs: {len(cameras)} cameras for {n} images")
+    from ..parallel.threads import thread_map
+
     out: list[PairMatches] = []
     t0 = time.perf_counter()
     tm = tg = 0.0
-    for k, (i, j) in enumerate(P):
-        check(prog)
-        prog.update(k / max(len(P), 1), f"matching pair {k + 1} of {len(P)}")
+
+    def one(pair) -> PairMatches:
+        i, j = int(pair[0]), int(pair[1])
         fi, fj = features[i], features[j]
         t = time.perf_counter()
         m, _ = match_descriptors(fi.descriptors, fj.descriptors, mcfg)
@@ -287,10 +293,12 @@ def match_pairs(
             pixel_scale=1.0 / min(fi.scale, fj.scale),
             matches=m,
         )
-        t2 = time.perf_counter()
-        tm += t1 - t
-        tg += t2 - t1
-        out.append(PairMatches(int(i), int(j), len(m), geo, t1 - t, t2 - t1))
+        return PairMatches(i, j, len(m), geo, t1 - t, time.perf_counter() - t1)
+
+    for r in thread_map(one, P, threads, prog, lambda k, n: f"matching pair {k + 1} of {n}"):
+        tm += r.seconds_matching
+        tg += r.seconds_geometry
+        out.append(r)
     prog.update(1.0, f"matched {len(P)} pairs")
     stats = {
         "pairs": len(P),

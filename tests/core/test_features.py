@@ -119,6 +119,18 @@ def test_fountain_essential_pose_vs_ground_truth(fountain):
         assert 2.0 < g.median_angle_deg < 30.0
 
 
+def test_matching_results_do_not_depend_on_the_threads(fountain):
+    """Pairs matched on one thread and on three: the same matches, inliers and poses."""
+    paths, feats, cam, _ = fountain
+    pairs = [(0, 1), (1, 2), (2, 3), (3, 5), (4, 5), (0, 2)]
+    one, _ = match_pairs(feats, pairs, [cam] * 11, threads=1)
+    three, _ = match_pairs(feats, pairs, [cam] * 11, threads=3)
+    for a, b in zip(one, three, strict=True):
+        assert (a.i, a.j, a.n_putative) == (b.i, b.j, b.n_putative)
+        assert np.array_equal(a.geometry.inliers, b.geometry.inliers)
+        assert np.array_equal(a.geometry.R, b.geometry.R) and np.array_equal(a.geometry.t, b.geometry.t)
+
+
 def test_fountain_fundamental_without_k(fountain):
     paths, feats, cam, _ = fountain
     res, _ = match_pairs(feats, [(0, 1), (4, 5), (9, 10)])
