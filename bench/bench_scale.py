@@ -328,7 +328,12 @@ def main(argv=None) -> int:
     if args.write_docs:
         commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                                 text=True).stdout.strip()  # fmt: skip
-        cmd = 'make bench BENCH=scale BENCH_ARGS="' + " ".join(sys.argv[1:]) + '"'
+        argv = sys.argv[1:]
+        if "--keep" in argv:  # a local folder, not part of what is measured
+            k = argv.index("--keep")
+            argv = argv[:k] + argv[k + 2 :]
+        argv = [a for a in argv if not a.startswith("--keep=")]
+        cmd = 'make bench BENCH=scale BENCH_ARGS="' + " ".join(argv) + '"'
         block = [f"Command: `{cmd}` at commit {commit}, {time.strftime('%Y-%m-%d')}, "
                  f"{os.cpu_count()} cores, {platform.machine()}.", ""] + lines  # fmt: skip
         write_section(DOCS, "scale", block)

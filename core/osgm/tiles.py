@@ -162,4 +162,8 @@ def task_memory(rows: int, cols: int, nd: int, n_images: int, window_pixels: int
     volumes = cells * int(nd) * 2 * 2  # cost + aggregated, uint16
     windows = int(n_images) * int(window_pixels) * 4  # float32 image windows
     per_cell = cells * 4 * 16  # lo, hi, z0, guide, remapped slices, level, confidence, ...
-    return volumes + windows + per_cell
+    n = int(n_images)
+    # the plane sweep's work arrays (.sweep): samples, gradients and validity per image, terms per pair
+    sweep = cells * (n * (4 + 2 + 2 + 1) + (n * (n - 1) // 2) * 3)
+    # and its windows packed once more into one buffer
+    return volumes + 2 * windows + per_cell + sweep
