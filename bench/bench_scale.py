@@ -228,15 +228,10 @@ def run_pipeline(folder: str, checks: list[str], resolution: float, log) -> dict
     products = os.path.join(folder, "products")
     args = [f"IMAGES={folder}/images", f"GCPS={folder}/gcps.gpkg", f"OBSERVATIONS={folder}/obs.gpkg",
             f"RESOLUTION={resolution}", f"OUTPUT_FOLDER={products}"]  # fmt: skip
-    t = time.perf_counter()
-    p = subprocess.run([QP, "run", "truortho:pipeline", "--", *args], capture_output=True, text=True)
-    wall = time.perf_counter() - t
-    with open(os.path.join(folder, "pipeline.log"), "w") as fh:
-        fh.write(p.stdout + p.stderr)
-    if p.returncode:
-        raise SystemExit(f"the pipeline failed (see {folder}/pipeline.log):\n{p.stderr[-2000:]}")
     sys.path.insert(0, HERE)
-    from real_blocks import picture
+    from real_blocks import picture, qgis_pipeline
+
+    wall = qgis_pipeline(args, folder, os.path.basename(folder))
 
     picture(products, os.path.join(HERE, "results", "scale", f"{os.path.basename(folder)}.jpg"))
     with open(os.path.join(products, "report.json")) as fh:

@@ -58,6 +58,19 @@ BLOCKS = {
 }
 
 
+def qgis_pipeline(args: list[str], folder: str, label: str) -> float:
+    """``truortho:pipeline`` through ``qgis_process`` with ``args``; its output goes to
+    ``folder/pipeline.log``. Returns the wall time, seconds; a failure ends the bench."""
+    t = time.perf_counter()
+    p = subprocess.run([QP, "run", "truortho:pipeline", "--", *args], capture_output=True, text=True)
+    seconds = time.perf_counter() - t
+    with open(os.path.join(folder, "pipeline.log"), "w") as fh:
+        fh.write(p.stdout + p.stderr)
+    if p.returncode:
+        raise SystemExit(f"{label}: the pipeline failed (see {folder}/pipeline.log):\n{p.stderr[-2000:]}")
+    return seconds
+
+
 def run_block(name: str, out: str, resolution: float, log) -> dict:
     images, gcps, checks = BLOCKS[name]
     if not os.path.isdir(images):
@@ -70,13 +83,7 @@ def run_block(name: str, out: str, resolution: float, log) -> dict:
         subprocess.run(imp, check=True, capture_output=True)
         args += [f"GCPS={out}/gcps.gpkg", f"OBSERVATIONS={out}/obs.gpkg"]
     log(f"{name}: truortho:pipeline on {len(os.listdir(images))} photos")
-    t = time.perf_counter()
-    p = subprocess.run([QP, "run", "truortho:pipeline", "--", *args], capture_output=True, text=True)
-    seconds = time.perf_counter() - t
-    with open(os.path.join(out, "pipeline.log"), "w") as fh:
-        fh.write(p.stdout + p.stderr)
-    if p.returncode:
-        raise SystemExit(f"{name}: the pipeline failed (see {out}/pipeline.log):\n{p.stderr[-2000:]}")
+    seconds = qgis_pipeline(args, out, name)
     m = measures(os.path.join(out, "products"))
     m.update(block=name, seconds=seconds)
     picture(os.path.join(out, "products"), os.path.join(HERE, "results", "real", f"{name}.jpg"))
