@@ -284,6 +284,32 @@ def _default_resolution(surface, orientation: Orientation, out_crs) -> float:
     return float(np.median(g))
 
 
+#: Bytes one tile's visibility and mosaic may take, candidates included (:func:`_bounded_tiles`).
+TILE_MEMORY_BUDGET = 512 << 20
+#: Smallest side a tile is cut down to, cells.
+MIN_TILE_SIZE = 128
+
+
+def _bounded_tiles(setup, grid, to_local, tile_size: int, overlap: int, bands: int):
+    """Tiles whose work fits :data:`TILE_MEMORY_BUDGET`: ``(tile_size, tiles, candidates per tile)``.
+
+    A tile's visibility buffers grow with its cells times its candidate images. At a coarse
+    resolution a tile of the configured size spans a large part of a big block, and every
+    image becomes a candidate (105 photos at 4x GSD: 1.2 GB per tile, two in flight). The side is
+    halved, down to :data:`MIN_TILE_SIZE`, until the costliest tile fits; the products do not
+    depend on the tiling beyond the seamlines' placement.
+    """
+    size = int(tile_size)
+    while True:
+        tiles = grid.tiles(size, overlap)
+        k_tile = tile_candidates(setup, grid, tiles, to_local)
+        k_max = int(max(1, k_tile.max())) if len(k_tile) else 1
+        need = task_memory(side_of(size, overlap), setup.margin_cells, k_max, bands, 0)
+        if need <= TILE_MEMORY_BUDGET or size // 2 < MIN_TILE_SIZE:
+            return size, tiles, k_tile
+        size //= 2
+
+
 def true_ortho(
     orientation,
     surface,
@@ -466,7 +492,8 @@ def true_ortho(
     }
     # ---- tiles, in waves (the costliest of a wave first; results do not depend on the order)
     overlap = max(cfg.blend_width, 4) + 8
-    tiles = grid.tiles(cfg.tile_size, overlap)
+    tile_size, tiles, k_tile = _bounded_tiles(setup, grid, to_local, cfg.tile_size, overlap, bands)
+    stats["tile_size"] = tile_size
     sub = steps[2]
     ctx = OrthoContext(
         setup,
@@ -483,11 +510,10 @@ def true_ortho(
         workers,
         store=store,
     )
-    k_tile = tile_candidates(setup, grid, tiles, to_local)
     k_max = int(max(1, k_tile.max()))
     cost = dict(zip((t.index for t in tiles), tile_costs(setup, grid, tiles, k_tile), strict=True))
     # a wave runs in batches of at most ~256 MiB of results, so the client's memory is bounded
-    per_tile = (cfg.tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
+    per_tile = (tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
     batch_tiles = max(1, (256 << 20) // per_tile)
     ordered = [sorted(w, key=lambda t: (-cost[t.index], t.index)) for w in waves(tiles)]
     batches = [w[i : i + batch_tiles] for w in ordered for i in range(0, len(w), batch_tiles)]
@@ -550,7 +576,7 @@ def true_ortho(
         done = DoneLabels(overlap)  # border strips of the labels of finished tiles
         img_bytes = max(w * h for w, h in (sizes[i] for i in relevant)) * bands * dtype.itemsize * 4 // 3
         memory = task_memory(
-            side_of(cfg.tile_size, overlap),
+            side_of(tile_size, overlap),
             setup.margin_cells,
             k_max,
             bands,

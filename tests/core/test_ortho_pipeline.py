@@ -184,6 +184,26 @@ def test_tiles_do_not_change_the_result(data):
     assert small.stats["tiles"] > 1 and big.stats["tiles"] == 1
 
 
+def test_tiles_shrink_to_the_memory_budget_and_keep_the_quality(data, monkeypatch):
+    """A tile whose cells x candidate images exceed the budget is cut down (big blocks at coarse
+    resolutions: every image is a candidate of a large tile); the mosaic keeps its quality."""
+    from truortho.core.ortho import pipeline as op
+
+    ref = _run(data, "budget_ref", color_correction=False)
+    assert ref.stats["tile_size"] == 512
+    monkeypatch.setattr(op, "TILE_MEMORY_BUDGET", 40 << 20)
+    small = _run(data, "budget_small", color_correction=False)
+    assert op.MIN_TILE_SIZE <= small.stats["tile_size"] < 512 and small.stats["tiles"] > ref.stats["tiles"]
+    assert small.stats["task_memory_mb"] < ref.stats["task_memory_mb"]
+    mr, ms = _measures(data, ref.output), _measures(data, small.output)
+    print("one tile", mr, "\nbudget tiles", ms, small.stats["tile_size"])
+    assert ms["ghost"] <= max(0.01, 1.5 * mr["ghost"])
+    assert ms["coverage"] == mr["coverage"] and abs(ms["dE"] - mr["dE"]) <= 0.5
+    monkeypatch.setattr(op, "TILE_MEMORY_BUDGET", 1)  # never below the smallest tile
+    tiny = _run(data, "budget_tiny", color_correction=False)
+    assert tiny.stats["tile_size"] >= op.MIN_TILE_SIZE
+
+
 def test_views_per_cell_keeps_what_is_seen_and_the_quality(data):
     """Lazy candidates (VIEWS_PER_CELL): fewer (cell, image) samples, the same cells seen and
     occluded (a cell short of views tries every image), ghosting and dE as with every image."""
