@@ -41,9 +41,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from ..jit import njit, pjit, prange
 from ..sgm import COST_MAX
-from ..sgm.cost import _GQ, _combine, _diff1, _need, _window_cells
+from ..sgm.cost import _GQ, _combine, _diff1, _gradient_scale, _gradients, _need, _quantise, _window_cells
 
 #: Rows per parallel strip of the window sums.
 STRIP = 32
@@ -117,37 +118,31 @@ def _box(mask, margin):
 
 
 @njit
+def _dilate_line(src, dst, lo, hi, rad):
+    """``dst[k] = 1`` where ``src`` has a non-zero within ``rad`` of ``k``, for ``lo <= k < hi``
+    (only ``src[lo:hi]`` is read; running count)."""
+    acc = 0
+    for k in range(lo, min(hi, lo + rad)):
+        acc += src[k]
+    for k in range(lo, hi):
+        if k + rad < hi:
+            acc += src[k + rad]
+        if k - rad - 1 >= lo:
+            acc -= src[k - rad - 1]
+        dst[k] = 1 if acc > 0 else 0
+
+
+@njit
 def _dilate(mask, rad, box, tmp, out):
-    """Box dilation (``(2 rad + 1)^2``) of a uint8 mask inside ``box`` (separable running counts).
+    """Box dilation (``(2 rad + 1)^2``) of a uint8 mask inside ``box`` (separable: rows, then columns).
 
     Only the cells of ``box`` are written; the mask must be zero outside it.
     """
     b0, b1, d0, d1 = box[0], box[1], box[2], box[3]
     for r in range(b0, b1):
-        acc = 0
-        for c in range(d0, min(d1, d0 + rad)):
-            acc += mask[r, c]
-        for c in range(d0, d1):
-            if c + rad < d1:
-                acc += mask[r, c + rad]
-            if c - rad - 1 >= d0:
-                acc -= mask[r, c - rad - 1]
-            tmp[r, c] = 1 if acc > 0 else 0
+        _dilate_line(mask[r], tmp[r], d0, d1, rad)
     for c in range(d0, d1):
-        acc = 0
-        for r in range(b0, min(b1, b0 + rad)):
-            acc += tmp[r, c]
-        for r in range(b0, b1):
-            if r + rad < b1:
-                acc += tmp[r + rad, c]
-            if r - rad - 1 >= b0:
-                acc -= tmp[r - rad - 1, c]
-            out[r, c] = 1 if acc > 0 else 0
-
-
-@njit
-def _quantise(g, inv):
-    return np.int16(round(min(float(_GQ), max(-float(_GQ), g * inv))))
+        _dilate_line(tmp[:, c], out[:, c], b0, b1, rad)
 
 
 @pjit
@@ -342,32 +337,16 @@ def _window_cost(td, tm, vv, need, win, box, radius, min_valid, best_k, pi, pj, 
                     cost[r, c, kk] = np.uint16(min(cmax, m * cmax + 0.5))
 
 
-@njit
-def _median_abs_grad(s, axis):
-    """Median |gradient| of one sampled slice (rows, cols) along columns (0) or rows (1), 0 if none."""
-    rows, cols = s.shape
-    vals = np.empty(rows * cols, np.float64)
-    m = 0
-    for r in range(rows):
-        for c in range(cols):
-            if axis == 0:
-                a = s[r, c - 1] if c > 0 else np.nan
-                b = s[r, c + 1] if c < cols - 1 else np.nan
-            else:
-                a = s[r - 1, c] if r > 0 else np.nan
-                b = s[r + 1, c] if r < rows - 1 else np.nan
-            g = _diff1(a, s[r, c], b)
-            if g == g:
-                vals[m] = abs(g)
-                m += 1
-    if m == 0:
-        return 0.0
-    v = vals[:m]
-    med = np.median(v)
-    if med <= 0.0:
-        nz = v[v > 0.0]
-        med = nz.mean() if nz.size > 0 else 0.0
-    return med
+def slice_scales(sl: np.ndarray) -> tuple[float, float]:
+    """The saturation scales of one sampled slice (rows, cols): median |gradient| along columns
+    and along rows, as :func:`~truortho.core.sgm.cost._saturate` takes them (0 without gradient)."""
+    s = np.ascontiguousarray(sl, np.float64)
+    if s.ndim != 2:
+        raise InputError(f"slice_scales: expected a 2-D slice, got shape {s.shape}")
+    gx = np.empty(s.shape, np.float64)
+    gy = np.empty(s.shape, np.float64)
+    _gradients(s, gx, gy)
+    return float(_gradient_scale(gx)), float(_gradient_scale(gy))
 
 
 def gradient_scales(images, sample, x0, y0, res, rows, cols, z) -> np.ndarray:
@@ -381,9 +360,7 @@ def gradient_scales(images, sample, x0, y0, res, rows, cols, z) -> np.ndarray:
     r0, c0 = (rows - h) // 2, (cols - w) // 2
     out = np.zeros((len(images), 2), np.float64)
     for i, im in enumerate(images):
-        sl = np.asarray(sample(im, x0 + c0 * res, y0 - r0 * res, res, h, w, z), np.float64)
-        for ax in (0, 1):
-            out[i, ax] = _median_abs_grad(sl, ax)
+        out[i] = slice_scales(sample(im, x0 + c0 * res, y0 - r0 * res, res, h, w, z))
     return out
 
 
@@ -416,7 +393,26 @@ class PlaneSweep:
     def plane(
         self, x0, y0, res, z, need: np.ndarray, a: int, z0: np.ndarray, cost: np.ndarray, best_k=0
     ) -> None:
-        """Costs of plane ``z`` (absolute level ``a``) for the cells with ``need`` into ``cost``."""
+        """Costs of plane ``z`` (absolute level ``a``) for the cells with ``need`` into ``cost``.
+
+        ``need`` (rows, cols) bool; ``z0`` (rows, cols) int32 and ``cost`` (rows, cols, nd) uint16,
+        C-ordered (written in place), with ``0 <= a - z0 < nd`` wherever ``need`` is set (the
+        caller's per-cell windows guarantee it; the kernels do not check it again).
+        """
+        shape = self.samp.shape
+        if np.shape(need) != shape or np.shape(z0) != shape:
+            raise InputError(
+                f"PlaneSweep.plane: need and z0 must be {shape}, got {np.shape(need)}, {np.shape(z0)}"
+            )
+        if z0.dtype != np.int32 or not z0.flags.c_contiguous:
+            raise InputError("PlaneSweep.plane: z0 must be a C-ordered int32 array")
+        if (
+            cost.ndim != 3
+            or cost.shape[:2] != shape
+            or cost.dtype != np.uint16
+            or not cost.flags.c_contiguous
+        ):
+            raise InputError(f"PlaneSweep.plane: cost must be a C-ordered uint16 {shape} x nd volume")
         need8 = np.ascontiguousarray(need, np.uint8)
         box = np.array(_box(need8, self.radius + 1), np.int64)
         if box[1] <= box[0]:

@@ -500,6 +500,13 @@ def _saturate(g, q, v):
     samples (a regular stride through the slice); a zero median (a mostly
     flat slice) uses the mean of the non-zero |g| instead.
     """
+    _saturate_with(g, _gradient_scale(g), q, v)
+
+
+@njit
+def _gradient_scale(g):
+    """The saturation scale of :func:`_saturate`: median |g| over at most ``_MEDIAN_SAMPLES``
+    valid samples (a regular stride), the mean of the non-zero |g| when that is 0, 0 without any."""
     flat = g.ravel()
     stride = max(1, flat.size // _MEDIAN_SAMPLES)
     vals = np.abs(flat[::stride])
@@ -510,7 +517,13 @@ def _saturate(g, q, v):
         if scale <= 0.0:
             nz = vals[vals > 0.0]
             scale = nz.mean() if nz.size > 0 else 0.0
-    _saturate_with(g, scale, q, v)
+    return scale
+
+
+@njit
+def _quantise(x, inv):
+    """``round(x inv)`` clipped to ``[-Q, Q]``, int16."""
+    return np.int16(round(min(float(_GQ), max(-float(_GQ), x * inv))))
 
 
 @njit
@@ -525,7 +538,7 @@ def _saturate_with(g, scale, q, v):
                 q[r, c] = 0
                 v[r, c] = 0
             else:
-                q[r, c] = np.int16(round(min(float(_GQ), max(-float(_GQ), x * inv))))
+                q[r, c] = _quantise(x, inv)
                 v[r, c] = 1
 
 

@@ -108,7 +108,7 @@ def test_given_scales_are_checked():
 
 
 def test_given_scales_equal_to_the_slices_own_give_the_same_cost():
-    from truortho.core.osgm.sweep import _median_abs_grad
+    from truortho.core.osgm.sweep import slice_scales
 
     rng = np.random.default_rng(5)
     s = cv2.GaussianBlur(rng.uniform(0, 255, (40, 50)).astype(np.float32), (0, 0), 1.0)
@@ -116,7 +116,7 @@ def test_given_scales_equal_to_the_slices_own_give_the_same_cost():
     slices = np.stack([np.roll(s, k, axis=1) + noise[k] for k in range(4)])
     slices[1, :, :5] = np.nan
     own, _ = multi_image_cost(slices, 2, measure="gradient")
-    sc = np.array([[_median_abs_grad(x.astype(np.float64), ax) for ax in (0, 1)] for x in slices])
+    sc = np.array([slice_scales(x) for x in slices])
     given, _ = multi_image_cost(slices, 2, measure="gradient", scales=sc)
     assert np.array_equal(own, given)
     doubled, _ = multi_image_cost(slices, 2, measure="gradient", scales=2 * sc)
@@ -152,3 +152,20 @@ def test_sweep_kernels_without_the_jit():
     sw._window_cost.py_func(p.td, p.tm, p.vv, need8, p.win, box, 1, 0.5, 0, p.pi, p.pj, 0, z0, got)
     assert np.array_equal(got, want)
     assert np.all(got[need] < 9999) and np.all(got[~need] == 9999)
+
+
+def test_plane_checks_its_arrays():
+    from truortho.core.errors import InputError
+
+    rng = np.random.default_rng(4)
+    images = _images(rng, 2, 10, 12)
+    p = PlaneSweep(images, 10, 12, 2, 0.5, np.ones((2, 2)))
+    need = np.ones((10, 12), bool)
+    z0 = np.zeros((10, 12), np.int32)
+    cost = np.zeros((10, 12, 2), np.uint16)
+    with pytest.raises(InputError, match="need and z0"):
+        p.plane(0.0, 0.0, RES, Z, need[:5], 0, z0, cost)
+    with pytest.raises(InputError, match="int32"):
+        p.plane(0.0, 0.0, RES, Z, need, 0, z0.astype(np.int64), cost)
+    with pytest.raises(InputError, match="uint16"):
+        p.plane(0.0, 0.0, RES, Z, need, 0, z0, cost.astype(np.int32))
