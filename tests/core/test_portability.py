@@ -50,3 +50,37 @@ def test_peak_memory_everywhere(monkeypatch):
     monkeypatch.setitem(sys.modules, "resource", None)
     assert memory.peak_rss_mb() is None  # a platform that cannot tell: no error
     assert truortho.core is not None
+
+
+class _FakeResource:
+    """A stand-in for ``resource`` whose peak is 2 GiB in the platform's own unit."""
+
+    RUSAGE_SELF = 0
+
+    def __init__(self, maxrss: int):
+        self._maxrss = maxrss
+
+    def getrusage(self, who):
+        assert who == self.RUSAGE_SELF
+        return type("Usage", (), {"ru_maxrss": self._maxrss})()
+
+
+def test_peak_memory_units(monkeypatch):
+    """ru_maxrss counts kB on Linux and bytes on macOS; both give MiB."""
+    from truortho.core import memory
+
+    monkeypatch.setattr(sys, "platform", "linux")
+    monkeypatch.setitem(sys.modules, "resource", _FakeResource(2 * 1024 * 1024))  # kB
+    assert memory.peak_rss_mb() == 2048.0
+    monkeypatch.setattr(sys, "platform", "darwin")
+    monkeypatch.setitem(sys.modules, "resource", _FakeResource(2 * 1024**3))  # bytes
+    assert memory.peak_rss_mb() == 2048.0
+
+
+def test_peak_memory_windows_without_psapi(monkeypatch):
+    """On "win32" the helper asks psapi and never touches ``resource``; no psapi gives None, not an error."""
+    from truortho.core import memory
+
+    monkeypatch.setattr(sys, "platform", "win32")
+    monkeypatch.setitem(sys.modules, "resource", _FakeResource(1))  # must not be read
+    assert memory.peak_rss_mb() is None  # this Linux ctypes has no windll
