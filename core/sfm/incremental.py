@@ -407,11 +407,11 @@ def _point_descriptors(st: _State, features, tracks: np.ndarray, exclude_image: 
         parts_off.append(parts_off[-1] + len(o))
     img = np.concatenate(imgs) if imgs else np.zeros(0, np.int64)
     fe = np.concatenate(feats) if feats else np.zeros(0, np.int64)
-    dim = features[0].descriptors.shape[1] if len(features) and features[0].descriptors.ndim == 2 else 128
+    dim = features[0].descriptor_rows(np.zeros(0, np.int64)).shape[-1] if len(features) else 128
     desc = np.zeros((len(img), dim), np.float32)
     for i in np.unique(img):
         sel = img == i
-        desc[sel] = features[int(i)].descriptors[fe[sel]]
+        desc[sel] = features[int(i)].descriptor_rows(fe[sel])
     return np.array(parts_off, dtype=np.int64), desc
 
 

@@ -229,7 +229,7 @@ def retrieval_pairs(features, config: PairConfig | None = None) -> PairSelection
     t0 = time.perf_counter()
     rng = np.random.default_rng(cfg.seed)
     per = max(1, 20000 // max(n, 1))
-    sample = [f.descriptors[rng.permutation(len(f))[:per]] for f in features if len(f)]
+    sample = [f.descriptor_rows(rng.permutation(len(f))[:per]) for f in features if len(f)]
     allsample = np.concatenate(sample) if sample else np.zeros((0, 128), np.float32)
     k = min(cfg.vocabulary_size, len(allsample))
     if n < 2 or k < 2:

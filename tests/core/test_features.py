@@ -56,6 +56,10 @@ def test_features_full_resolution_coordinates_and_cache(fountain):
     assert 1000 < len(f) <= 8000 and f.descriptors.shape == (len(f), 128)
     assert f.descriptors.dtype == np.float32
     assert np.allclose(np.linalg.norm(f.descriptors, axis=1), 1.0, atol=1e-4)  # RootSIFT
+    # in memory only the raw uint8 SIFT values (a quarter of float32); rows convert alone
+    assert f.sift.dtype == np.uint8 and f.sift.shape == (len(f), 128)
+    rows = np.array([5, 0, len(f) - 1])
+    assert np.array_equal(f.descriptor_rows(rows), f.descriptors[rows])
     assert (f.width, f.height) == (3072, 2048) and f.scale == pytest.approx(1000 / 3072, rel=1e-3)
     assert f.xy[:, 0].max() > 2500 and f.xy[:, 1].max() > 1500 and f.xy.min() > -0.5
     assert f.colors.shape == (len(f), 3) and f.colors.dtype == np.uint8
@@ -66,6 +70,7 @@ def test_features_full_resolution_coordinates_and_cache(fountain):
     g = extract_features(paths[0], FeatureConfig(max_dimension=1000, root_sift=False), cache_dir=cache)
     assert time.perf_counter() - t < 0.2
     assert np.array_equal(g.xy, f.xy) and not np.allclose(g.descriptors, f.descriptors)
+    assert np.array_equal(g.descriptors, f.sift.astype(np.float32))
 
 
 def test_feature_errors_and_cancel(tmp_path):

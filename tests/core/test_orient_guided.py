@@ -24,6 +24,16 @@ from truortho.core.sfm.similarity import estimate_similarity
 CAM = Camera(1200, 800, 1000.0, 1000.0, 601.3, 398.2, -0.05, 0.01, 0.0, 2e-4, -1e-4)
 
 
+class _Feats:
+    """The part of :class:`~truortho.core.sfm.features.Features` registration reads (float descriptors)."""
+
+    def __init__(self, xy, descriptors) -> None:
+        self.xy, self.descriptors = xy, descriptors
+
+    def descriptor_rows(self, rows):
+        return self.descriptors[rows]
+
+
 def weak_group_block(
     seed=0, group_sees_strip=True, descriptor_noise=0.08, noise_px=0.3, clutter=0.3, complete=False
 ):
@@ -89,7 +99,7 @@ def weak_group_block(
             ]
         )
         d /= np.linalg.norm(d, axis=1, keepdims=True)
-        features.append(SimpleNamespace(xy=f_xy, descriptors=d.astype(np.float32)))
+        features.append(_Feats(f_xy, d.astype(np.float32)))
         t = np.flatnonzero(in_track[i, pts])
         tr.append(pts[t])
         im.append(np.full(len(t), i))
@@ -164,7 +174,7 @@ def test_displaced_features_give_no_scale(block):
     # the group's features of the missed points moved by 15-80 px (descriptors kept): what lies near
     # an epipolar segment with a similar descriptor is then chance, and no scale is significant
     rng = np.random.default_rng(5)
-    feats = [SimpleNamespace(xy=f.xy.copy(), descriptors=f.descriptors) for f in block["features"]]
+    feats = [_Feats(f.xy.copy(), f.descriptors) for f in block["features"]]
     for g in range(3):
         in_track = np.zeros(len(feats[g].xy), bool)
         in_track[block["feature"][block["image"] == g]] = True
