@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import dataclasses
+import importlib
+from typing import Any
+
 from qgis.core import (
     QgsProcessing,
     QgsProcessingAlgorithm,
@@ -21,12 +25,83 @@ GROUPS = {
 }
 
 
+@dataclasses.dataclass(frozen=True)
+class FromConfig:
+    """A parameter whose default is the default of a field of a core config dataclass.
+
+    Attributes
+    ----------
+    config : str
+        ``"module.Class"`` under ``truortho.core``, e.g. ``"surface.filter.DsmFilterConfig"``
+        (resolved when the algorithm is initialised, so the algorithm modules import no core code).
+    field : str
+        Field of that dataclass.
+    choices : tuple or str
+        For an enum parameter: the core values in the order of the options (or ``"module.NAME"``
+        of such a tuple under ``truortho.core``); the default is the index of the field's default
+        among them.
+    none : Any
+        The parameter's value that stands for the field's ``None`` (e.g. ``0.0`` = automatic).
+    """
+
+    config: str
+    field: str
+    choices: tuple | str = ()
+    none: Any = None
+
+    def config_class(self) -> type:
+        return _core_attribute(self.config)
+
+    def field_default(self) -> Any:
+        """The dataclass field's default value."""
+        f = {f.name: f for f in dataclasses.fields(self.config_class())}[self.field]
+        if f.default is not dataclasses.MISSING:
+            return f.default
+        if f.default_factory is not dataclasses.MISSING:
+            return f.default_factory()
+        raise KeyError(f"{self.config}.{self.field} has no default")
+
+    def value(self) -> Any:
+        """The parameter's default."""
+        default = self.field_default()
+        if self.choices:
+            choices = _core_attribute(self.choices) if isinstance(self.choices, str) else self.choices
+            return tuple(choices).index(default)
+        return self.none if default is None else default
+
+
+def _core_attribute(path: str) -> Any:
+    """``"module.NAME"`` under ``truortho.core`` -> the object."""
+    module, _, name = path.rpartition(".")
+    return getattr(importlib.import_module(f"truortho.core.{module}"), name)
+
+
+#: Values of the EXECUTOR parameter (:func:`truortho.core.parallel.make_executor`).
+EXECUTOR_CHOICES = ("inprocess", "local", "scheduler")
+
+
+def executor_default(config: str) -> FromConfig:
+    """EXECUTOR's default from the ``executor`` field of ``config``."""
+    return FromConfig(config, "executor", EXECUTOR_CHOICES)
+
+
 class TruOrthoAlgorithm(QgsProcessingAlgorithm):
-    """Base class: subclasses set ``NAME``, ``DISPLAY_NAME`` and ``GROUP_ID``."""
+    """Base class: subclasses set ``NAME``, ``DISPLAY_NAME`` and ``GROUP_ID``.
+
+    ``CONFIG_DEFAULTS`` maps a parameter to the config field that defines its default
+    (:meth:`default`); ``OWN_DEFAULTS`` names, with the reason, the parameters with a default that
+    no config field defines. ``tests/qgis/test_defaults.py`` checks both for every algorithm.
+    """
 
     NAME = ""
     DISPLAY_NAME = ""
     GROUP_ID = "tools"
+    CONFIG_DEFAULTS: dict[str, FromConfig] = {}
+    OWN_DEFAULTS: dict[str, str] = {}
+
+    def default(self, name: str) -> Any:
+        """Default of parameter ``name``: its config field's default (``CONFIG_DEFAULTS``)."""
+        return self.CONFIG_DEFAULTS[name].value()
 
     def name(self) -> str:
         return self.NAME
@@ -56,8 +131,7 @@ class TruOrthoAlgorithm(QgsProcessingAlgorithm):
         self.addParameter(param)
         return param
 
-    #: Values of the EXECUTOR parameter (:func:`truortho.core.parallel.make_executor`).
-    EXECUTOR_CHOICES = ("inprocess", "local", "scheduler")
+    EXECUTOR_CHOICES = EXECUTOR_CHOICES
 
     def add_executor(self) -> None:
         """The advanced EXECUTOR and SCHEDULER_ADDRESS parameters of the tiled algorithms."""
@@ -74,7 +148,7 @@ class TruOrthoAlgorithm(QgsProcessingAlgorithm):
                     tr("local: a Dask cluster of worker processes on this computer"),
                     tr("scheduler: a Dask scheduler (SCHEDULER_ADDRESS)"),
                 ],
-                defaultValue=0,
+                defaultValue=self.default("EXECUTOR") if "EXECUTOR" in self.CONFIG_DEFAULTS else 0,
             ),
             advanced=True,
         )

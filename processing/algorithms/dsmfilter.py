@@ -16,7 +16,7 @@ from qgis.core import (
 
 from ..feedback import FeedbackProgress, core_errors
 from ..i18n import tr
-from .base import TruOrthoAlgorithm
+from .base import FromConfig, TruOrthoAlgorithm
 
 
 def _optional_number(alg, parameters, name, context):
@@ -58,6 +58,23 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
     CELLS_FILLED = "CELLS_FILLED"
     HOLES_REMAINING = "HOLES_REMAINING"
 
+    CONFIG_DEFAULTS = {
+        OUTLIER_THRESHOLD: FromConfig("surface.filter.DsmFilterConfig", "outlier_threshold"),
+        OUTLIER_WINDOW: FromConfig("surface.filter.DsmFilterConfig", "outlier_window"),
+        MIN_SUPPORT: FromConfig("surface.filter.DsmFilterConfig", "min_support"),
+        MIN_CONFIDENCE: FromConfig("surface.filter.DsmFilterConfig", "min_confidence"),
+        CONFIDENT: FromConfig("surface.filter.DsmFilterConfig", "confident"),
+        MAX_HOLE: FromConfig("surface.filter.DsmFilterConfig", "max_hole"),
+        STEP: FromConfig("surface.filter.DsmFilterConfig", "step"),
+        SHARPEN: FromConfig("surface.filter.DsmFilterConfig", "sharpen"),
+        SMOOTH: FromConfig("surface.filter.DsmFilterConfig", "smooth"),
+        SMOOTH_RADIUS: FromConfig("surface.filter.DsmFilterConfig", "smooth_radius"),
+        SMOOTH_TOLERANCE: FromConfig("surface.filter.DsmFilterConfig", "smooth_tolerance"),
+        DTM_RESOLUTION: FromConfig("surface.dtm.DtmConfig", "resolution"),
+        MAX_WINDOW: FromConfig("surface.dtm.DtmConfig", "max_window"),
+        SLOPE: FromConfig("surface.dtm.DtmConfig", "slope"),
+    }
+    OWN_DEFAULTS = {"EXECUTOR": "filter_dsm takes the executor as an argument: inprocess, the first option"}
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         num = QgsProcessingParameterNumber
@@ -70,16 +87,28 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
                 self.OUTLIER_THRESHOLD,
                 tr("Outlier threshold (m; empty = 4 x resolution)"),
                 num.Double,
-                None,
+                self.default(self.OUTLIER_THRESHOLD),
                 optional=True,
                 minValue=0.0,
             )
         )
-        self.add(num(self.MAX_HOLE, tr("Largest hole width filled (m)"), num.Double, 10.0, minValue=0.0))
-        self.add(QgsProcessingParameterBoolean(self.SHARPEN, tr("Sharpen blurred height steps"), True))
+        self.add(
+            num(
+                self.MAX_HOLE,
+                tr("Largest hole width filled (m)"),
+                num.Double,
+                self.default(self.MAX_HOLE),
+                minValue=0.0,
+            )
+        )
         self.add(
             QgsProcessingParameterBoolean(
-                self.SMOOTH, tr("Edge-preserving smoothing of planar surfaces"), False
+                self.SHARPEN, tr("Sharpen blurred height steps"), self.default(self.SHARPEN)
+            )
+        )
+        self.add(
+            QgsProcessingParameterBoolean(
+                self.SMOOTH, tr("Edge-preserving smoothing of planar surfaces"), self.default(self.SMOOTH)
             )
         )
         self.add(
@@ -87,18 +116,31 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
                 self.OUTLIER_WINDOW,
                 tr("Outlier window (cells, odd)"),
                 num.Integer,
-                5,
+                self.default(self.OUTLIER_WINDOW),
                 minValue=3,
                 maxValue=15,
             ),
             advanced=True,
         )
         self.add(
-            num(self.MIN_SUPPORT, tr("Supporting neighbours that keep a cell"), num.Integer, 4, minValue=0),
+            num(
+                self.MIN_SUPPORT,
+                tr("Supporting neighbours that keep a cell"),
+                num.Integer,
+                self.default(self.MIN_SUPPORT),
+                minValue=0,
+            ),
             advanced=True,
         )
         self.add(
-            num(self.MIN_CONFIDENCE, tr("Minimum confidence"), num.Double, 0.05, minValue=0.0, maxValue=1.0),
+            num(
+                self.MIN_CONFIDENCE,
+                tr("Minimum confidence"),
+                num.Double,
+                self.default(self.MIN_CONFIDENCE),
+                minValue=0.0,
+                maxValue=1.0,
+            ),
             advanced=True,
         )
         self.add(
@@ -106,18 +148,31 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
                 self.CONFIDENT,
                 tr("Confident cells (confidence at least)"),
                 num.Double,
-                0.4,
+                self.default(self.CONFIDENT),
                 minValue=0.0,
                 maxValue=1.0,
             ),
             advanced=True,
         )
         self.add(
-            num(self.STEP, tr("Height step between surfaces (m)"), num.Double, 1.0, minValue=0.01),
+            num(
+                self.STEP,
+                tr("Height step between surfaces (m)"),
+                num.Double,
+                self.default(self.STEP),
+                minValue=0.01,
+            ),
             advanced=True,
         )
         self.add(
-            num(self.SMOOTH_RADIUS, tr("Smoothing radius (cells)"), num.Integer, 2, minValue=1, maxValue=7),
+            num(
+                self.SMOOTH_RADIUS,
+                tr("Smoothing radius (cells)"),
+                num.Integer,
+                self.default(self.SMOOTH_RADIUS),
+                minValue=1,
+                maxValue=7,
+            ),
             advanced=True,
         )
         self.add(
@@ -125,7 +180,7 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
                 self.SMOOTH_TOLERANCE,
                 tr("Smoothing height tolerance (m; empty = 2.5 x resolution)"),
                 num.Double,
-                None,
+                self.default(self.SMOOTH_TOLERANCE),
                 optional=True,
                 minValue=0.0,
             ),
@@ -136,18 +191,30 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
                 self.DTM_RESOLUTION,
                 tr("Ground filter cell size (m; empty = max(1 m, resolution))"),
                 num.Double,
-                None,
+                self.default(self.DTM_RESOLUTION),
                 optional=True,
                 minValue=0.0,
             ),
             advanced=True,
         )
         self.add(
-            num(self.MAX_WINDOW, tr("Ground filter window radius (m)"), num.Double, 18.0, minValue=0.1),
+            num(
+                self.MAX_WINDOW,
+                tr("Ground filter window radius (m)"),
+                num.Double,
+                self.default(self.MAX_WINDOW),
+                minValue=0.1,
+            ),
             advanced=True,
         )
         self.add(
-            num(self.SLOPE, tr("Ground filter slope (rise/run)"), num.Double, 0.15, minValue=0.001),
+            num(
+                self.SLOPE,
+                tr("Ground filter slope (rise/run)"),
+                num.Double,
+                self.default(self.SLOPE),
+                minValue=0.001,
+            ),
             advanced=True,
         )
         self.add_executor()
@@ -195,9 +262,7 @@ class DsmFilterAlgorithm(TruOrthoAlgorithm):
             smooth_tolerance=_optional_number(self, parameters, self.SMOOTH_TOLERANCE, context),
         )
         executor_kind, address = self.executor_choice(parameters, context)
-        executor = make_executor(
-            executor_kind, address
-        )
+        executor = make_executor(executor_kind, address)
         progress = FeedbackProgress(feedback)
         steps = Steps(progress, [3, 1 if (dtm or ndsm) else 0])
         try:

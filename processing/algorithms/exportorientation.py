@@ -26,6 +26,8 @@ class ExportOrientationAlgorithm(TruOrthoAlgorithm):
     OUTPUT = "OUTPUT"
     FILES = "FILES"
 
+    OWN_DEFAULTS = {FORMAT: "the first format of FORMATS, no config"}
+
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(QgsProcessingParameterFile(self.INPUT, tr("Orientation (TruOrtho JSON)"), extension="json"))
         self.add(

@@ -18,7 +18,7 @@ from qgis.core import (
 from ..feedback import core_errors
 from ..i18n import tr
 from ..layers import gcp_feature, gcp_fields, observation_features, observation_fields, qgs_crs
-from .base import TruOrthoAlgorithm
+from .base import FromConfig, TruOrthoAlgorithm
 
 
 class ImportGcpsAlgorithm(TruOrthoAlgorithm):
@@ -34,6 +34,12 @@ class ImportGcpsAlgorithm(TruOrthoAlgorithm):
     GCPS = "GCPS"
     OBSERVATIONS = "OBSERVATIONS"
 
+    # the accuracies the adjustment assumes for a GCP without its own
+    CONFIG_DEFAULTS = {
+        SIGMA_XY: FromConfig("sfm.georef.GeorefConfig", "gcp_sigma_xy"),
+        SIGMA_Z: FromConfig("sfm.georef.GeorefConfig", "gcp_sigma_z"),
+    }
+
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(QgsProcessingParameterFile(self.INPUT, tr("GCP list (ODM gcp_list.txt)")))
         self.add(
@@ -46,7 +52,7 @@ class ImportGcpsAlgorithm(TruOrthoAlgorithm):
                 self.SIGMA_XY,
                 tr("Default sigma XY [m]"),
                 QgsProcessingParameterNumber.Double,
-                0.02,
+                self.default(self.SIGMA_XY),
                 minValue=1e-6,
             )
         )
@@ -55,7 +61,7 @@ class ImportGcpsAlgorithm(TruOrthoAlgorithm):
                 self.SIGMA_Z,
                 tr("Default sigma Z [m]"),
                 QgsProcessingParameterNumber.Double,
-                0.03,
+                self.default(self.SIGMA_Z),
                 minValue=1e-6,
             )
         )

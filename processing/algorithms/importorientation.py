@@ -55,6 +55,8 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
     CAMERAS = "CAMERAS"
     FOOTPRINTS = "FOOTPRINTS"
 
+    OWN_DEFAULTS = {FOOTPRINT_HEIGHT: "empty = default_footprint_height of the orientation, no config"}
+
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
             QgsProcessingParameterFile(self.INPUT, tr("Orientation file (COLMAP, Orthority CSV, OpenSfM)"))

@@ -16,7 +16,7 @@ from qgis.core import (
 
 from ..feedback import FeedbackProgress, core_errors
 from ..i18n import tr
-from .base import TruOrthoAlgorithm
+from .base import FromConfig, TruOrthoAlgorithm
 from .dsmfilter import _optional_number
 
 POINT_CLOUD_SUFFIXES = (".las", ".laz")
@@ -42,6 +42,17 @@ class MeshAlgorithm(TruOrthoAlgorithm):
 
     FRAMES = ["crs", "local"]
 
+    CONFIG_DEFAULTS = {
+        MAX_ERROR: FromConfig("surface.mesh.DsmMeshConfig", "max_error"),
+        MIN_STEP: FromConfig("surface.mesh.DsmMeshConfig", "min_step"),
+        MAX_SLOPE: FromConfig("surface.mesh.DsmMeshConfig", "max_slope_deg"),
+        MAX_LEAF: FromConfig("surface.mesh.DsmMeshConfig", "max_leaf"),
+    }
+    OWN_DEFAULTS = {
+        MAX_EDGE: "an argument of mesh_from_point_cloud (None = automatic), no config",
+        FRAME: "output coordinates, not a meshing parameter: the CRS (first option)",
+    }
+
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         num = QgsProcessingParameterNumber
         self.add(
@@ -59,20 +70,26 @@ class MeshAlgorithm(TruOrthoAlgorithm):
                 self.MAX_ERROR,
                 tr("Largest vertical error (m; empty = half the DSM resolution)"),
                 num.Double,
-                None,
+                self.default(self.MAX_ERROR),
                 optional=True,
                 minValue=0.0,
             )
         )
         self.add(
-            num(self.MIN_STEP, tr("Smallest height step made a wall (m)"), num.Double, 0.5, minValue=0.01)
+            num(
+                self.MIN_STEP,
+                tr("Smallest height step made a wall (m)"),
+                num.Double,
+                self.default(self.MIN_STEP),
+                minValue=0.01,
+            )
         )
         self.add(
             num(
                 self.MAX_SLOPE,
                 tr("Steepest slope kept as a surface (degrees)"),
                 num.Double,
-                70.0,
+                self.default(self.MAX_SLOPE),
                 minValue=1.0,
                 maxValue=89.9,
             ),
@@ -83,7 +100,7 @@ class MeshAlgorithm(TruOrthoAlgorithm):
                 self.MAX_LEAF,
                 tr("Largest flat block (cells, power of two)"),
                 num.Integer,
-                64,
+                self.default(self.MAX_LEAF),
                 minValue=1,
                 maxValue=256,
             ),

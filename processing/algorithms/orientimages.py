@@ -27,7 +27,7 @@ from qgis.PyQt.QtCore import QVariant
 from ..feedback import FeedbackProgress, core_errors
 from ..i18n import tr
 from ..layers import camera_features, camera_fields, crs_text, ground_control, qgs_crs
-from .base import TruOrthoAlgorithm
+from .base import FromConfig, TruOrthoAlgorithm
 
 
 def tie_point_fields() -> QgsFields:
@@ -69,6 +69,12 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
     TIE_POINTS = "TIE_POINTS"
     GCP_RESIDUALS = "GCP_RESIDUALS"
 
+    CONFIG_DEFAULTS = {
+        WORKING_SIZE: FromConfig("sfm.pipeline.OrientConfig", "working_size"),
+        MAX_FEATURES: FromConfig("sfm.pipeline.OrientConfig", "max_features"),
+        SELF_CALIBRATION: FromConfig("sfm.pipeline.OrientConfig", "self_calibration"),
+    }
+
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
             QgsProcessingParameterFile(
@@ -93,7 +99,7 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
                 self.WORKING_SIZE,
                 tr("Working resolution (max image side, px)"),
                 QgsProcessingParameterNumber.Integer,
-                2000,
+                self.default(self.WORKING_SIZE),
                 minValue=200,
             ),
             advanced=True,
@@ -103,13 +109,16 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
                 self.MAX_FEATURES,
                 tr("Features per image"),
                 QgsProcessingParameterNumber.Integer,
-                8000,
+                self.default(self.MAX_FEATURES),
                 minValue=100,
             ),
             advanced=True,
         )
         self.add(
-            QgsProcessingParameterBoolean(self.SELF_CALIBRATION, tr("Self-calibration"), True), advanced=True
+            QgsProcessingParameterBoolean(
+                self.SELF_CALIBRATION, tr("Self-calibration"), self.default(self.SELF_CALIBRATION)
+            ),
+            advanced=True,
         )
         self.add(
             QgsProcessingParameterFileDestination(

@@ -26,7 +26,7 @@ from qgis.core import (
 from ..feedback import FeedbackProgress, core_errors
 from ..i18n import tr
 from ..layers import qgs_crs
-from .base import TruOrthoAlgorithm
+from .base import FromConfig, TruOrthoAlgorithm, executor_default
 from .dsmfilter import _optional_number
 from .pointcloud import LAS_FILTER
 
@@ -62,6 +62,20 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
     PATH_CHOICES = [8, 16]
     OBLIQUE_CHOICES = ["none", "auto"]
 
+    CONFIG_DEFAULTS = {
+        RESOLUTION: FromConfig("osgm.pipeline.OsgmConfig", "resolution"),
+        Z_STEP: FromConfig("osgm.pipeline.OsgmConfig", "z_step"),
+        Z_MIN: FromConfig("osgm.pipeline.OsgmConfig", "z_min"),
+        Z_MAX: FromConfig("osgm.pipeline.OsgmConfig", "z_max"),
+        PATHS: FromConfig("osgm.pipeline.OsgmConfig", "paths", tuple(PATH_CHOICES)),
+        OBLIQUE: FromConfig("osgm.pipeline.OsgmConfig", "oblique", tuple(OBLIQUE_CHOICES)),
+        P1: FromConfig("osgm.pipeline.OsgmConfig", "p1"),
+        P2: FromConfig("osgm.pipeline.OsgmConfig", "p2"),
+        MAX_IMAGES: FromConfig("osgm.pipeline.OsgmConfig", "max_images"),
+        TILE_SIZE: FromConfig("osgm.pipeline.OsgmConfig", "tile_size"),
+        "EXECUTOR": executor_default("osgm.pipeline.OsgmConfig"),
+    }
+
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         num = QgsProcessingParameterNumber
         self.add(
@@ -77,7 +91,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
                 self.RESOLUTION,
                 tr("Resolution (m; empty or 0 = median ground sample distance)"),
                 num.Double,
-                None,
+                self.default(self.RESOLUTION),
                 optional=True,
                 minValue=0.0,
             )
@@ -87,7 +101,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
                 self.Z_STEP,
                 tr("Height step of the search (m; empty or 0 = the resolution)"),
                 num.Double,
-                None,
+                self.default(self.Z_STEP),
                 optional=True,
                 minValue=0.0,
             )
@@ -97,7 +111,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
                 self.Z_MIN,
                 tr("Lowest height searched (m; empty = automatic)"),
                 num.Double,
-                None,
+                self.default(self.Z_MIN),
                 optional=True,
             )
         )
@@ -106,7 +120,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
                 self.Z_MAX,
                 tr("Highest height searched (m; empty = automatic)"),
                 num.Double,
-                None,
+                self.default(self.Z_MAX),
                 optional=True,
             )
         )
@@ -120,7 +134,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
                 self.PATHS,
                 tr("Aggregation paths"),
                 options=[str(p) for p in self.PATH_CHOICES],
-                defaultValue=0,
+                defaultValue=self.default(self.PATHS),
             )
         )
         self.add(
@@ -128,7 +142,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
                 self.OBLIQUE,
                 tr("Oblique images"),
                 options=[tr("none: one nadir reference system"), tr("auto: extra systems for obliques")],
-                defaultValue=0,
+                defaultValue=self.default(self.OBLIQUE),
             )
         )
         self.add(
@@ -136,7 +150,7 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
                 self.P1,
                 tr("Penalty P1, one height step (cost units; empty = default)"),
                 num.Integer,
-                None,
+                self.default(self.P1),
                 optional=True,
                 minValue=0,
             ),
@@ -147,18 +161,31 @@ class OsgmAlgorithm(TruOrthoAlgorithm):
                 self.P2,
                 tr("Penalty P2, larger height jumps (cost units; empty = default)"),
                 num.Integer,
-                None,
+                self.default(self.P2),
                 optional=True,
                 minValue=0,
             ),
             advanced=True,
         )
         self.add(
-            num(self.MAX_IMAGES, tr("Images per tile (at most)"), num.Integer, 12, minValue=2),
+            num(
+                self.MAX_IMAGES,
+                tr("Images per tile (at most)"),
+                num.Integer,
+                self.default(self.MAX_IMAGES),
+                minValue=2,
+            ),
             advanced=True,
         )
         self.add(
-            num(self.TILE_SIZE, tr("Tile size (cells)"), num.Integer, 256, minValue=32, maxValue=8192),
+            num(
+                self.TILE_SIZE,
+                tr("Tile size (cells)"),
+                num.Integer,
+                self.default(self.TILE_SIZE),
+                minValue=32,
+                maxValue=8192,
+            ),
             advanced=True,
         )
         self.add_executor()

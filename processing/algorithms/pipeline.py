@@ -21,7 +21,7 @@ from qgis.core import (
 from ..feedback import FeedbackProgress, core_errors
 from ..i18n import tr
 from ..layers import crs_text, ground_control
-from .base import TruOrthoAlgorithm
+from .base import FromConfig, TruOrthoAlgorithm, executor_default
 
 
 class PipelineAlgorithm(TruOrthoAlgorithm):
@@ -39,6 +39,11 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
     EXECUTOR = "EXECUTOR"
     SCHEDULER_ADDRESS = "SCHEDULER_ADDRESS"
     OUTPUT_FOLDER = "OUTPUT_FOLDER"
+    CONFIG_DEFAULTS = {
+        RESOLUTION: FromConfig("workflow.WorkflowConfig", "resolution", none=0.0),
+        REUSE_ORIENTATION: FromConfig("workflow.WorkflowConfig", "reuse_orientation"),
+        EXECUTOR: executor_default("workflow.WorkflowConfig"),
+    }
     # outputs (files named in truortho.core.workflow.PRODUCTS)
     OUTPUTS = {
         "ORIENTATION": "orientation",
@@ -50,7 +55,6 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         "OCCLUSION": "occlusion",
         "SEAMLINES": "seamlines",
     }
-
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
@@ -71,13 +75,15 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
                 self.RESOLUTION,
                 tr("Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)"),
                 QgsProcessingParameterNumber.Double,
-                0.0,
+                self.default(self.RESOLUTION),
                 minValue=0.0,
             )
         )
         self.add(
             QgsProcessingParameterBoolean(
-                self.REUSE_ORIENTATION, tr("Reuse an existing orientation.json in the output folder"), False
+                self.REUSE_ORIENTATION,
+                tr("Reuse an existing orientation.json in the output folder"),
+                self.default(self.REUSE_ORIENTATION),
             )
         )
         self.add_executor()

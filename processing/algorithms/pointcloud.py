@@ -102,6 +102,8 @@ class MergePointCloudsAlgorithm(TruOrthoAlgorithm):
     EPT_JSON = "EPT_JSON"
     POINTS = "POINTS"
 
+    OWN_DEFAULTS = {VOXEL: "an argument of merge_point_clouds (None = keep all points), no config"}
+
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
             QgsProcessingParameterMultipleLayers(

@@ -25,7 +25,7 @@ from qgis.PyQt.QtCore import QVariant
 from ..feedback import FeedbackProgress, core_errors
 from ..i18n import tr
 from ..layers import crs_text, qgs_crs
-from .base import TruOrthoAlgorithm
+from .base import FromConfig, TruOrthoAlgorithm, executor_default
 
 
 def seamline_fields() -> QgsFields:
@@ -60,6 +60,20 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     OCCLUSION = "OCCLUSION"
     SEAMLINES = "SEAMLINES"
 
+    CONFIG_DEFAULTS = {
+        RESOLUTION: FromConfig("ortho.pipeline.TrueOrthoConfig", "resolution", none=0.0),
+        COLOR_CORRECTION: FromConfig("ortho.pipeline.TrueOrthoConfig", "color_correction"),
+        MAX_VIEW_ANGLE: FromConfig("ortho.pipeline.TrueOrthoConfig", "max_view_angle"),
+        BLEND_WIDTH: FromConfig("ortho.pipeline.TrueOrthoConfig", "blend_width"),
+        TILE_SIZE: FromConfig("ortho.pipeline.TrueOrthoConfig", "tile_size"),
+        # COMPRESSION's options are listed in the order of ORTHO_COMPRESSIONS
+        COMPRESSION: FromConfig(
+            "ortho.pipeline.TrueOrthoConfig", "compression", "ortho.pipeline.ORTHO_COMPRESSIONS"
+        ),
+        JPEG_QUALITY: FromConfig("ortho.pipeline.TrueOrthoConfig", "jpeg_quality"),
+        "EXECUTOR": executor_default("ortho.pipeline.TrueOrthoConfig"),
+    }
+
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
         self.add(
             QgsProcessingParameterFile(self.ORIENTATION, tr("Orientation (TruOrtho JSON)"), extension="json")
@@ -79,20 +93,24 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 self.RESOLUTION,
                 tr("Resolution (CRS units; 0 = the surface's cell size)"),
                 QgsProcessingParameterNumber.Double,
-                0.0,
+                self.default(self.RESOLUTION),
                 minValue=0.0,
             )
         )
         self.add(
             QgsProcessingParameterCrs(self.CRS, tr("Output CRS (default: the orientation's)"), optional=True)
         )
-        self.add(QgsProcessingParameterBoolean(self.COLOR_CORRECTION, tr("Colour correction"), True))
+        self.add(
+            QgsProcessingParameterBoolean(
+                self.COLOR_CORRECTION, tr("Colour correction"), self.default(self.COLOR_CORRECTION)
+            )
+        )
         self.add(
             QgsProcessingParameterNumber(
                 self.MAX_VIEW_ANGLE,
                 tr("Maximum off-nadir viewing angle (degrees)"),
                 QgsProcessingParameterNumber.Double,
-                45.0,
+                self.default(self.MAX_VIEW_ANGLE),
                 minValue=1.0,
                 maxValue=88.0,
             )
@@ -102,7 +120,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 self.BLEND_WIDTH,
                 tr("Blend width across seamlines (cells)"),
                 QgsProcessingParameterNumber.Integer,
-                5,
+                self.default(self.BLEND_WIDTH),
                 minValue=0,
                 maxValue=1000,
             )
@@ -112,7 +130,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 self.TILE_SIZE,
                 tr("Tile size (cells)"),
                 QgsProcessingParameterNumber.Integer,
-                512,
+                self.default(self.TILE_SIZE),
                 minValue=32,
                 maxValue=8192,
             ),
@@ -128,7 +146,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                     tr("LZW (lossless)"),
                     tr("JPEG (lossy, 8-bit RGB images only; alpha becomes a mask)"),
                 ],
-                defaultValue=0,
+                defaultValue=self.default(self.COMPRESSION),
             )
         )
         self.add(
@@ -136,7 +154,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 self.JPEG_QUALITY,
                 tr("JPEG quality"),
                 QgsProcessingParameterNumber.Integer,
-                90,
+                self.default(self.JPEG_QUALITY),
                 minValue=1,
                 maxValue=100,
             ),

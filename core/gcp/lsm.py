@@ -1,0 +1,775 @@
+"""Least-squares matching (LSM) and multi-image geometrically constrained matching (MGCM).
+
+A *template* (a patch of a master image, or an ideal rendering of a target) is matched into
+*search* images by Gauss-Newton on grey values:
+
+    T(u, v) = r0 + r1 * G(x(u, v), y(u, v)) + e
+
+with ``(u, v)`` the template's pixel offsets from its centre pixel (the template has odd
+height and width; its centre is the point being measured), ``G`` the search image resampled
+bilinearly, ``r0, r1`` a radiometric offset and gain, and the geometric shaping
+
+    w = 1 + c_u u + c_v v
+    x = (x0 + a_u u + a_v v) / w,   y = (y0 + b_u u + b_v v) / w
+
+(affine: ``c_u = c_v = 0``, 6 parameters; projective: 8). The measured point is the image of
+the template centre, ``(x0, y0)``. Pixel convention of :mod:`truortho.core.geometry`: the
+centre of the top-left pixel is (0, 0), x right, y down.
+
+:func:`lsm_match` matches one template into one image. :func:`mgcm` matches one template into
+several oriented images at once with the collinearity condition (Gruen & Baltsavias): each
+image's shift ``(x0, y0)`` is the projection of one object point ``X`` (local frame, metres),
+which is an unknown of the joint adjustment together with every image's shaping and
+radiometry. Including the master image (whose patch is the template) pins ``X`` to the master
+ray. Both return results, never raise on a failed estimation: ``converged`` False and a
+``reason``.
+
+Precision: ``sigma0`` is the standard deviation of the grey-value residuals (unit weight);
+the covariance of the unknowns is ``sigma0**2 N^-1``. In MGCM the image coordinates'
+covariance is the object point's propagated into each image.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import cv2
+import numpy as np
+
+from ..errors import InputError
+from ..geometry.camera import Camera, _distort_one, project_points, undistort_points
+from ..jit import njit
+
+#: Order of the 10 unknowns in the kernels' normal equations.
+#: 0 a_u, 1 a_v, 2 b_u, 3 b_v, 4 c_u, 5 c_v, 6 r0, 7 r1, 8 x0, 9 y0
+_AFFINE_LOCAL = np.array([0, 1, 2, 3, 6, 7])
+_PROJECTIVE_LOCAL = np.array([0, 1, 2, 3, 4, 5, 6, 7])
+_SHIFT = np.array([8, 9])
+
+
+@dataclass(frozen=True)
+class LsmConfig:
+    """Settings of least-squares matching.
+
+    Parameters
+    ----------
+    projective : bool
+        Projective (8 parameters) instead of affine (6) shaping.
+    max_iterations : int
+        Gauss-Newton iterations per stage.
+    tolerance : float
+        Convergence: largest change of the shift in an iteration, pixels.
+    max_shift : float
+        Failure when the point moves farther than this from its start, pixels.
+    coarse_sigma : float
+        Gaussian blur (pixels) of a first, coarse stage that widens the pull-in range for starts
+        a few pixels off; 0 = no coarse stage.
+    min_correlation : float
+        A converged match with a lower normalised cross-correlation is reported as not
+        converged (reason ``"low correlation"``).
+    """
+
+    projective: bool = False
+    max_iterations: int = 40
+    tolerance: float = 1e-3
+    max_shift: float = 6.0
+    coarse_sigma: float = 1.5
+    min_correlation: float = 0.5
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.max_iterations, int) and self.max_iterations >= 1):
+            raise InputError(f"LsmConfig.max_iterations must be a positive integer, got {self.max_iterations!r}")
+        for name in ("tolerance", "max_shift"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise InputError(f"LsmConfig.{name} must be positive, got {v!r}")
+        if not (math.isfinite(self.coarse_sigma) and self.coarse_sigma >= 0):
+            raise InputError(f"LsmConfig.coarse_sigma must be >= 0, got {self.coarse_sigma!r}")
+        if not -1.0 <= self.min_correlation <= 1.0:
+            raise InputError(f"LsmConfig.min_correlation must be in [-1, 1], got {self.min_correlation!r}")
+
+
+@dataclass(frozen=True)
+class LsmResult:
+    """Outcome of one match (also one image of an MGCM solution).
+
+    ``x, y``: the template centre in the search image (pixels); ``covariance`` (2, 2) px^2 and
+    ``sigma_x, sigma_y`` its standard deviations; ``correlation``: normalised cross-correlation
+    of the template and the resampled image at the solution; ``shape``: (2, 3) affine part
+    ``[[a_u, a_v, x0], [b_u, b_v, y0]]``; ``perspective``: ``(c_u, c_v)``; ``gain, offset``:
+    ``r1, r0``; ``sigma0``: grey-value residual standard deviation.
+    """
+
+    x: float
+    y: float
+    sigma_x: float
+    sigma_y: float
+    covariance: np.ndarray
+    correlation: float
+    iterations: int
+    converged: bool
+    reason: str
+    shape: np.ndarray = field(default_factory=lambda: np.full((2, 3), np.nan))
+    perspective: tuple[float, float] = (0.0, 0.0)
+    gain: float = float("nan")
+    offset: float = float("nan")
+    sigma0: float = float("nan")
+
+    def __bool__(self) -> bool:
+        return self.converged
+
+
+@dataclass(frozen=True)
+class MgcmView:
+    """One oriented search image of :func:`mgcm`.
+
+    ``image``: (H, W) grey values; ``R`` (3, 3) world-to-camera; ``C`` (3,) projection centre
+    in the local frame; ``camera``: its interior orientation; ``name`` for reports.
+    """
+
+    image: np.ndarray
+    R: np.ndarray
+    C: np.ndarray
+    camera: Camera
+    name: str = ""
+
+
+@dataclass(frozen=True)
+class MgcmResult:
+    """Outcome of :func:`mgcm`: the object point and one :class:`LsmResult` per view."""
+
+    X: np.ndarray
+    covariance: np.ndarray
+    views: list[LsmResult]
+    iterations: int
+    converged: bool
+    reason: str
+    sigma0: float
+
+    @property
+    def sigma(self) -> np.ndarray:
+        """Standard deviations of X, Y, Z (metres)."""
+        return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+
+    def __bool__(self) -> bool:
+        return self.converged
+
+
+# ---------------------------------------------------------------- kernels
+
+
+@njit
+def _bilinear(img, x, y):
+    """Bilinear value at (x, y); NaN outside the pixel centres' hull."""
+    h, w = img.shape
+    if not (x >= 0.0 and y >= 0.0 and x <= w - 1 and y <= h - 1):
+        return np.nan
+    x0 = min(int(x), w - 2) if w > 1 else 0
+    y0 = min(int(y), h - 2) if h > 1 else 0
+    fx = x - x0
+    fy = y - y0
+    x1 = min(x0 + 1, w - 1)
+    y1 = min(y0 + 1, h - 1)
+    top = img[y0, x0] * (1.0 - fx) + img[y0, x1] * fx
+    bot = img[y1, x0] * (1.0 - fx) + img[y1, x1] * fx
+    return top * (1.0 - fy) + bot * fy
+
+
+@njit
+def _normals(template, img, gx, gy, p, r0, r1, N, b, resampled):
+    """Normal equations of one image at parameters ``p`` (10, kernel order).
+
+    Fills ``N`` (10, 10), ``b`` (10,) and ``resampled`` (the image under the template);
+    returns ``(sum of squared residuals, number of samples, number outside the image)``.
+    """
+    th, tw = template.shape
+    hv = th // 2
+    hu = tw // 2
+    for i in range(10):
+        b[i] = 0.0
+        for j in range(10):
+            N[i, j] = 0.0
+    ssr = 0.0
+    n = 0
+    outside = 0
+    row = np.empty(10)
+    for iv in range(th):
+        v = float(iv - hv)
+        for iu in range(tw):
+            u = float(iu - hu)
+            w = 1.0 + p[4] * u + p[5] * v
+            if w <= 1e-6:
+                outside += 1
+                resampled[iv, iu] = np.nan
+                continue
+            x = (p[8] + p[0] * u + p[1] * v) / w
+            y = (p[9] + p[2] * u + p[3] * v) / w
+            g = _bilinear(img, x, y)
+            if np.isnan(g):
+                outside += 1
+                resampled[iv, iu] = np.nan
+                continue
+            resampled[iv, iu] = g
+            dgx = _bilinear(gx, x, y) * r1 / w
+            dgy = _bilinear(gy, x, y) * r1 / w
+            row[0] = dgx * u
+            row[1] = dgx * v
+            row[2] = dgy * u
+            row[3] = dgy * v
+            row[4] = -(dgx * x + dgy * y) * u
+            row[5] = -(dgx * x + dgy * y) * v
+            row[6] = 1.0
+            row[7] = g
+            row[8] = dgx
+            row[9] = dgy
+            e = template[iv, iu] - (r0 + r1 * g)
+            ssr += e * e
+            n += 1
+            for i in range(10):
+                b[i] += row[i] * e
+                for j in range(i, 10):
+                    N[i, j] += row[i] * row[j]
+    for i in range(10):
+        for j in range(i):
+            N[i, j] = N[j, i]
+    return ssr, n, outside
+
+
+# ---------------------------------------------------------------- helpers
+
+
+def _gray(a, what: str) -> np.ndarray:
+    arr = np.asarray(a)
+    if arr.ndim != 2 or min(arr.shape) < 3:
+        raise InputError(f"{what}: expected a 2-D grey image of at least 3x3 pixels, got shape {arr.shape}")
+    out = np.ascontiguousarray(arr, dtype=np.float64)
+    if not np.all(np.isfinite(out)):
+        raise InputError(f"{what}: contains NaN or infinite values")
+    return out
+
+
+def _check_template(template) -> np.ndarray:
+    t = _gray(template, "template")
+    if t.shape[0] % 2 == 0 or t.shape[1] % 2 == 0:
+        raise InputError(f"template: height and width must be odd (centre pixel = the point), got {t.shape}")
+    if float(np.std(t)) <= 1e-9 * max(1.0, float(np.abs(t).max())):
+        raise InputError("template: has no contrast (constant grey values)")
+    return t
+
+
+def _blur(a: np.ndarray, sigma: float) -> np.ndarray:
+    if sigma <= 0:
+        return a
+    return cv2.GaussianBlur(a, (0, 0), sigmaX=sigma, sigmaY=sigma, borderType=cv2.BORDER_REFLECT)
+
+
+def _gradients(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    gy, gx = np.gradient(a)
+    return np.ascontiguousarray(gx), np.ascontiguousarray(gy)
+
+
+def _reach(template_shape, p) -> float:
+    """Largest distance (pixels) of the template's footprint from its centre under ``p``."""
+    hv, hu = template_shape[0] // 2, template_shape[1] // 2
+    a = np.array([[p[0], p[1]], [p[2], p[3]]])
+    return float(np.abs(a).sum(axis=1).max() * max(hu, hv) * (1.0 + 4.0 * (abs(p[4]) * hu + abs(p[5]) * hv)))
+
+
+def _crop(image: np.ndarray, cx: float, cy: float, radius: float):
+    """Window of ``image`` around (cx, cy) of the given radius: (window, x offset, y offset)."""
+    h, w = image.shape
+    r = int(math.ceil(radius)) + 2
+    x0 = max(0, int(math.floor(cx)) - r)
+    y0 = max(0, int(math.floor(cy)) - r)
+    x1 = min(w, int(math.floor(cx)) + r + 2)
+    y1 = min(h, int(math.floor(cy)) + r + 2)
+    if x1 - x0 < 3 or y1 - y0 < 3:
+        return None, x0, y0
+    return np.ascontiguousarray(image[y0:y1, x0:x1], dtype=np.float64), x0, y0
+
+
+def _ncc(a: np.ndarray, b: np.ndarray) -> float:
+    ok = np.isfinite(b)
+    if ok.sum() < 3:
+        return float("nan")
+    x = a[ok] - a[ok].mean()
+    y = b[ok] - b[ok].mean()
+    d = math.sqrt(float((x * x).sum() * (y * y).sum()))
+    return float((x * y).sum() / d) if d > 0 else 0.0
+
+
+def _initial_params(x: float, y: float, initial) -> np.ndarray:
+    p = np.zeros(10)
+    p[0] = p[3] = 1.0
+    if initial is not None:
+        m = np.asarray(initial, dtype=np.float64)
+        if m.shape == (2, 3):
+            m = np.vstack([m, [0.0, 0.0, 1.0]])
+        if m.shape != (3, 3) or not np.all(np.isfinite(m)) or abs(m[2, 2]) < 1e-12:
+            raise InputError(f"initial: expected a (2, 3) affine or (3, 3) projective matrix, got {np.shape(initial)}")
+        m = m / m[2, 2]
+        p[0], p[1], p[2], p[3] = m[0, 0], m[0, 1], m[1, 0], m[1, 1]
+        p[4], p[5] = m[2, 0], m[2, 1]
+    p[8], p[9] = x, y
+    return p
+
+
+def _failed(x, y, it, reason, corr=float("nan")) -> LsmResult:
+    return LsmResult(float(x), float(y), float("nan"), float("nan"), np.full((2, 2), np.nan), corr, it, False, reason)
+
+
+#: Marquardt damping of the shaping parameters during the iterations: a rotationally symmetric
+#: target (a disc) leaves the rotation of the shaping undetermined, and undamped steps let the
+#: shape wander along that null direction. The centre and the final covariance are undamped.
+_SHAPE_DAMPING = 0.1
+
+
+def _damped(N: np.ndarray, shape_idx) -> np.ndarray:
+    Nd = N.copy()
+    Nd[shape_idx, shape_idx] *= 1.0 + _SHAPE_DAMPING
+    return Nd
+
+
+def _solve(N: np.ndarray, b: np.ndarray):
+    """Solution and inverse of a small normal matrix; None when (nearly) singular."""
+    scale = np.sqrt(np.clip(np.diag(N), 1e-300, None))
+    Ns = N / np.outer(scale, scale)
+    try:
+        if np.linalg.cond(Ns) > 1e12:
+            return None
+        inv = np.linalg.inv(Ns) / np.outer(scale, scale)
+    except np.linalg.LinAlgError:
+        return None
+    return inv @ b, inv
+
+
+# ---------------------------------------------------------------- LSM
+
+
+def _lsm_stage(t, window, ox, oy, p, r, cfg, start, it0):
+    """Gauss-Newton iterations on one (possibly blurred) stage; returns (p, r, it, reason, extras)."""
+    gx, gy = _gradients(window)
+    local = _PROJECTIVE_LOCAL if cfg.projective else _AFFINE_LOCAL
+    idx = np.concatenate([local, _SHIFT])
+    N = np.zeros((10, 10))
+    b = np.zeros(10)
+    res = np.zeros(t.shape)
+    pc = p.copy()
+    pc[8] -= ox
+    pc[9] -= oy
+    it = it0
+    sol = None
+    ssr, n = 0.0, 0
+    for _ in range(cfg.max_iterations):
+        it += 1
+        ssr, n, outside = _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
+        if outside:
+            return pc, r, it, "left the image", None
+        shape_idx = np.arange(len(local) - 2)
+        sol = _solve(_damped(N[np.ix_(idx, idx)], shape_idx), b[idx])
+        if sol is None:
+            return pc, r, it, "singular (no texture)", None
+        d = sol[0]
+        full = np.zeros(10)
+        full[idx] = d
+        pc[:6] += full[:6]
+        r = (r[0] + full[6], r[1] + full[7])
+        pc[8] += full[8]
+        pc[9] += full[9]
+        if not np.all(np.isfinite(pc)) or r[1] <= 0:
+            return pc, r, it, "diverged", None
+        if math.hypot(pc[8] + ox - start[0], pc[9] + oy - start[1]) > cfg.max_shift:
+            return pc, r, it, "moved farther than max_shift", None
+        det = pc[0] * pc[3] - pc[1] * pc[2]
+        if not 0.1 < abs(det) < 10.0:
+            return pc, r, it, "degenerate shape", None
+        if math.hypot(full[8], full[9]) < cfg.tolerance:
+            ssr, n, outside = _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
+            if outside:
+                return pc, r, it, "left the image", None
+            sol = _solve(N[np.ix_(idx, idx)], b[idx]) or _solve(_damped(N[np.ix_(idx, idx)], shape_idx), b[idx])
+            if sol is None:
+                return pc, r, it, "singular (no texture)", None
+            pc[8] += ox
+            pc[9] += oy
+            return pc, r, it, "", (ssr, n, len(idx), sol[1], res.copy())
+    return pc, r, it, "no convergence", None
+
+
+def lsm_match(template, image, x: float, y: float, config: LsmConfig | None = None, initial=None) -> LsmResult:
+    """Match a template into an image by least squares from a start position.
+
+    Parameters
+    ----------
+    template : (h, w) array, h and w odd
+        Grey values; its centre pixel is the point to measure.
+    image : (H, W) array
+        Search image (grey values on the template's scale up to a gain and offset).
+    x, y : float
+        Start position of the template centre in ``image``, pixels ((0, 0) = centre of the
+        top-left pixel).
+    config : LsmConfig, optional
+    initial : (2, 3) or (3, 3) array, optional
+        Start of the shaping (template offsets -> image pixels; its translation column is
+        ignored, ``x, y`` is the start). Default: identity.
+
+    Returns
+    -------
+    LsmResult
+        ``converged`` False with a ``reason`` when the estimation fails (never raises on data).
+
+    Raises
+    ------
+    InputError
+        For malformed inputs (shapes, non-finite values, constant template).
+    """
+    cfg = config or LsmConfig()
+    t = _check_template(template)
+    img = _gray(image, "image")
+    if not (math.isfinite(x) and math.isfinite(y)):
+        raise InputError(f"lsm_match: start position must be finite, got ({x}, {y})")
+    p = _initial_params(float(x), float(y), initial)
+    h, w = img.shape
+    if not (0 <= x <= w - 1 and 0 <= y <= h - 1):
+        return _failed(x, y, 0, "start outside the image")
+    r = (0.0, 1.0)
+    # radiometric start: match means and spreads
+    it = 0
+    stages = [cfg.coarse_sigma, 0.0] if cfg.coarse_sigma > 0 else [0.0]
+    extras = None
+    for s in stages:
+        radius = _reach(t.shape, p) + cfg.max_shift + 3.0 * s + 2.0
+        window, ox, oy = _crop(img, p[8], p[9], radius)
+        if window is None:
+            return _failed(p[8], p[9], it, "start outside the image")
+        tw = _blur(t, s)
+        ww = _blur(window, s)
+        pc = p.copy()
+        pc[8] -= ox
+        pc[9] -= oy
+        probe = np.zeros(t.shape)
+        _normals(tw, ww, *_gradients(ww), pc, 0.0, 1.0, np.zeros((10, 10)), np.zeros(10), probe)
+        ok = np.isfinite(probe)
+        if ok.sum() > 3 and np.std(probe[ok]) > 0:
+            r1 = float(np.std(tw[ok]) / np.std(probe[ok]))
+            r = (float(tw[ok].mean() - r1 * probe[ok].mean()), r1)
+        p, r, it, reason, extras = _lsm_stage(tw, ww, ox, oy, p, r, cfg, (x, y), it)
+        if reason:
+            return _failed(p[8] + ox, p[9] + oy, it, reason)
+    assert extras is not None
+    ssr, n, k, inv, res = extras
+    dof = max(n - k, 1)
+    sigma0 = math.sqrt(ssr / dof)
+    cov = sigma0**2 * inv[-2:, -2:]
+    corr = _ncc(t, res)
+    converged = bool(corr >= cfg.min_correlation)
+    return LsmResult(
+        float(p[8]),
+        float(p[9]),
+        float(math.sqrt(max(cov[0, 0], 0.0))),
+        float(math.sqrt(max(cov[1, 1], 0.0))),
+        cov,
+        corr,
+        it,
+        converged,
+        "" if converged else "low correlation",
+        np.array([[p[0], p[1], p[8]], [p[2], p[3], p[9]]]),
+        (float(p[4]), float(p[5])),
+        float(r[1]),
+        float(r[0]),
+        sigma0,
+    )
+
+
+def extract_template(image, x: float, y: float, half_size: int) -> np.ndarray:
+    """The ``(2 half_size + 1)^2`` patch of ``image`` centred (bilinearly) on ``(x, y)``.
+
+    Raises
+    ------
+    InputError
+        When the patch does not lie inside the image.
+    """
+    img = _gray(image, "image")
+    if not (isinstance(half_size, int | np.integer) and half_size >= 1):
+        raise InputError(f"half_size must be a positive integer, got {half_size!r}")
+    n = 2 * int(half_size) + 1
+    p = _initial_params(float(x), float(y), None)
+    out = np.zeros((n, n))
+    _normals(np.zeros((n, n)), img, img, img, p, 0.0, 1.0, np.zeros((10, 10)), np.zeros(10), out)
+    if not np.all(np.isfinite(out)):
+        raise InputError(f"template at ({x:.1f}, {y:.1f}) with half size {half_size} reaches outside the image")
+    return out
+
+
+# ---------------------------------------------------------------- MGCM
+
+
+@njit
+def _project_one(X, R, C, p, out):
+    dx = X[0] - C[0]
+    dy = X[1] - C[1]
+    dz = X[2] - C[2]
+    zc = R[2, 0] * dx + R[2, 1] * dy + R[2, 2] * dz
+    if not zc > 0.0:
+        out[0] = np.nan
+        out[1] = np.nan
+        return zc
+    xc = R[0, 0] * dx + R[0, 1] * dy + R[0, 2] * dz
+    yc = R[1, 0] * dx + R[1, 1] * dy + R[1, 2] * dz
+    u, v = _distort_one(xc / zc, yc / zc, p)
+    out[0] = u
+    out[1] = v
+    return zc
+
+
+@njit
+def _project_jac(X, R, C, p, uv, J):
+    """Pixel ``uv`` (2,) of X and its derivative ``J`` (2, 3) by central differences."""
+    depth = _project_one(X, R, C, p, uv)
+    h = max(1e-6, 1e-6 * abs(depth))
+    Y = X.copy()
+    a = np.empty(2)
+    b = np.empty(2)
+    for k in range(3):
+        Y[k] = X[k] + h
+        _project_one(Y, R, C, p, a)
+        Y[k] = X[k] - h
+        _project_one(Y, R, C, p, b)
+        Y[k] = X[k]
+        J[0, k] = (a[0] - b[0]) / (2.0 * h)
+        J[1, k] = (a[1] - b[1]) / (2.0 * h)
+
+
+def _project_with_jacobian(X: np.ndarray, view: MgcmView) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel of X in a view and its (2, 3) derivative (NaN behind the camera)."""
+    uv = np.empty(2)
+    J = np.empty((2, 3))
+    _project_jac(
+        np.ascontiguousarray(X, dtype=np.float64),
+        np.ascontiguousarray(view.R, dtype=np.float64),
+        np.ascontiguousarray(view.C, dtype=np.float64).reshape(3),
+        view.camera.params,
+        uv,
+        J,
+    )
+    return uv, J
+
+
+def plane_shape(master: MgcmView, view: MgcmView, X, normal=(0.0, 0.0, 1.0)) -> np.ndarray:
+    """Affine start (2, 2) of the shaping from ``master`` pixels to ``view`` pixels at ``X``.
+
+    The local homography induced by the plane through ``X`` (local frame) with ``normal``
+    (default horizontal: ground targets), linearised at the projection of ``X`` (central
+    differences of one pixel). NaN when a ray misses the plane.
+    """
+    Xv = np.asarray(X, dtype=np.float64).reshape(3)
+    nrm = np.asarray(normal, dtype=np.float64).reshape(3)
+    uv0 = project_points(Xv[None], master.R, master.C, master.camera)[0]
+    offs = np.array([[1.0, 0.0], [-1.0, 0.0], [0.0, 1.0], [0.0, -1.0]])
+    xy = undistort_points(uv0[None] + offs, master.camera)
+    d = np.column_stack([xy, np.ones(4)]) @ np.asarray(master.R, dtype=np.float64)
+    Cm = np.asarray(master.C, dtype=np.float64).reshape(3)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lam = ((Xv - Cm) @ nrm) / (d @ nrm)
+    pts = Cm[None] + lam[:, None] * d
+    q = project_points(pts, view.R, view.C, view.camera)
+    return np.column_stack([(q[0] - q[1]) / 2.0, (q[2] - q[3]) / 2.0])
+
+
+def mgcm(
+    template, views, X0, config: LsmConfig | None = None, master: int | None = None, initial_shapes=None
+) -> MgcmResult:
+    """Multi-image geometrically constrained least-squares matching.
+
+    Parameters
+    ----------
+    template : (h, w) array, h and w odd
+        The patch to find (its centre pixel is the point), e.g. from
+        :func:`extract_template` on a master image that is also one of ``views``.
+    views : sequence of MgcmView
+        Oriented search images (at least two).
+    X0 : (3,) float
+        Start of the object point, local frame, metres.
+    config : LsmConfig, optional
+        ``max_shift`` bounds the movement of every projection from its start.
+    master : int, optional
+        Index of the view the template was cut from: the other views' shaping starts from the
+        geometry (:func:`plane_shape` on the horizontal plane through ``X0``).
+    initial_shapes : sequence of (2, 2) arrays, optional
+        Start of every view's shaping (template offsets -> pixels); overrides ``master``.
+
+    Returns
+    -------
+    MgcmResult
+        The object point ``X`` (3,) with its covariance (3, 3) m^2 and per view the projection
+        of ``X`` with its propagated covariance, the correlation, gain/offset and shape.
+        ``converged`` False with a ``reason`` on failure.
+    """
+    cfg = config or LsmConfig()
+    t = _check_template(template)
+    X = np.asarray(X0, dtype=np.float64).reshape(-1)
+    if X.shape != (3,) or not np.all(np.isfinite(X)):
+        raise InputError(f"mgcm: X0 must be 3 finite numbers, got {X0!r}")
+    views = list(views)
+    if len(views) < 2:
+        raise InputError(f"mgcm: needs at least two views, got {len(views)}")
+    imgs = [_gray(v.image, f"view {v.name or i!r} image") for i, v in enumerate(views)]
+    local = _PROJECTIVE_LOCAL if cfg.projective else _AFFINE_LOCAL
+    k = len(local)
+    nv = len(views)
+    starts = []
+    for v in views:
+        uv, _ = _project_with_jacobian(X, v)
+        if not np.all(np.isfinite(uv)):
+            return _mgcm_failed(X, nv, 0, f"X0 is behind view {v.name!r}")
+        starts.append(uv)
+    params = np.zeros((nv, 10))
+    params[:, 0] = params[:, 3] = 1.0
+    if initial_shapes is not None:
+        shapes = [np.asarray(a, dtype=np.float64) for a in initial_shapes]
+        if len(shapes) != nv or any(a.shape != (2, 2) or not np.all(np.isfinite(a)) for a in shapes):
+            raise InputError(f"mgcm: initial_shapes must be {nv} finite (2, 2) arrays")
+    elif master is not None:
+        if not (isinstance(master, int | np.integer) and 0 <= master < nv):
+            raise InputError(f"mgcm: master must be a view index in [0, {nv}), got {master!r}")
+        shapes = [np.eye(2) if j == master else plane_shape(views[master], v, X) for j, v in enumerate(views)]
+        if any(not np.all(np.isfinite(a)) for a in shapes):
+            return _mgcm_failed(X, nv, 0, "a view's start shaping is undefined (ray parallel to the plane)")
+    else:
+        shapes = [np.eye(2)] * nv
+    for j, a in enumerate(shapes):
+        params[j, 0], params[j, 1], params[j, 2], params[j, 3] = a[0, 0], a[0, 1], a[1, 0], a[1, 1]
+    radiometry = np.tile([0.0, 1.0], (nv, 1))
+    it = 0
+    stages = [cfg.coarse_sigma, 0.0] if cfg.coarse_sigma > 0 else [0.0]
+    final = None
+    for s in stages:
+        tw = _blur(t, s)
+        prepared = []
+        for j, (v, img) in enumerate(zip(views, imgs, strict=True)):
+            uv, _ = _project_with_jacobian(X, v)
+            params[j, 8:] = uv
+            radius = _reach(t.shape, params[j]) + cfg.max_shift + 3.0 * s + 2.0
+            window, ox, oy = _crop(img, uv[0], uv[1], radius)
+            if window is None:
+                return _mgcm_failed(X, nv, it, f"view {v.name!r}: the point is outside the image")
+            ww = _blur(window, s)
+            gx, gy = _gradients(ww)
+            prepared.append((ww, gx, gy, ox, oy))
+            if it == 0:
+                probe = np.zeros(t.shape)
+                pc = params[j].copy()
+                pc[8] -= ox
+                pc[9] -= oy
+                _normals(tw, ww, gx, gy, pc, 0.0, 1.0, np.zeros((10, 10)), np.zeros(10), probe)
+                ok = np.isfinite(probe)
+                if ok.sum() > 3 and np.std(probe[ok]) > 0:
+                    r1 = float(np.std(tw[ok]) / np.std(probe[ok]))
+                    radiometry[j] = (float(tw[ok].mean() - r1 * probe[ok].mean()), r1)
+        for _ in range(cfg.max_iterations):
+            it += 1
+            n_unk = 3 + nv * k
+            NN = np.zeros((n_unk, n_unk))
+            bb = np.zeros(n_unk)
+            ssr_total, n_total = 0.0, 0
+            jac = []
+            residual_patches = []
+            for j, v in enumerate(views):
+                ww, gx, gy, ox, oy = prepared[j]
+                uv, A = _project_with_jacobian(X, v)
+                if not np.all(np.isfinite(uv)) or not np.all(np.isfinite(A)):
+                    return _mgcm_failed(X, nv, it, f"view {v.name!r}: the point left the field of view")
+                params[j, 8:] = uv
+                jac.append(A)
+                pc = params[j].copy()
+                pc[8] -= ox
+                pc[9] -= oy
+                N = np.zeros((10, 10))
+                b = np.zeros(10)
+                res = np.zeros(t.shape)
+                ssr, n, outside = _normals(tw, ww, gx, gy, pc, radiometry[j, 0], radiometry[j, 1], N, b, res)
+                if outside:
+                    return _mgcm_failed(X, nv, it, f"view {v.name!r}: the template left the image")
+                residual_patches.append(res)
+                ssr_total += ssr
+                n_total += n
+                sl = slice(3 + j * k, 3 + (j + 1) * k)
+                NLL = N[np.ix_(local, local)]
+                NLS = N[np.ix_(local, _SHIFT)]
+                NSS = N[np.ix_(_SHIFT, _SHIFT)]
+                NN[:3, :3] += A.T @ NSS @ A
+                NN[:3, sl] += A.T @ NLS.T
+                NN[sl, :3] += NLS @ A
+                NN[sl, sl] += NLL
+                bb[:3] += A.T @ b[_SHIFT]
+                bb[sl] += b[local]
+            shape_idx = np.concatenate([3 + j * k + np.arange(k - 2) for j in range(nv)])
+            sol = _solve(_damped(NN, shape_idx), bb)
+            undamped = _solve(NN, bb)
+            if sol is None:
+                return _mgcm_failed(X, nv, it, "singular (no texture or parallel rays)")
+            d = sol[0]
+            inv = (undamped or sol)[1]
+            X = X + d[:3]
+            for j in range(nv):
+                dl = np.zeros(10)
+                dl[local] = d[3 + j * k : 3 + (j + 1) * k]
+                params[j, :6] += dl[:6]
+                radiometry[j] += dl[6:8]
+            moves = []
+            for j, v in enumerate(views):
+                uv, _ = _project_with_jacobian(X, v)
+                if not np.all(np.isfinite(uv)):
+                    return _mgcm_failed(X, nv, it, f"view {v.name!r}: the point left the field of view")
+                moves.append(float(np.hypot(*(uv - params[j, 8:]))))
+                if float(np.hypot(*(uv - starts[j]))) > cfg.max_shift:
+                    return _mgcm_failed(X, nv, it, f"view {v.name!r}: moved farther than max_shift")
+                det = params[j, 0] * params[j, 3] - params[j, 1] * params[j, 2]
+                if not 0.1 < abs(det) < 10.0 or radiometry[j, 1] <= 0:
+                    return _mgcm_failed(X, nv, it, f"view {v.name!r}: degenerate shape")
+                params[j, 8:] = uv
+            if max(moves) < cfg.tolerance:
+                final = (ssr_total, n_total, n_unk, inv, jac, residual_patches)
+                break
+        else:
+            return _mgcm_failed(X, nv, it, "no convergence")
+    assert final is not None
+    ssr_total, n_total, n_unk, inv, jac, patches = final
+    sigma0 = math.sqrt(ssr_total / max(n_total - n_unk, 1))
+    covX = sigma0**2 * inv[:3, :3]
+    results = []
+    converged = True
+    for j, v in enumerate(views):
+        cov = jac[j] @ covX @ jac[j].T
+        corr = _ncc(t, patches[j])
+        ok = bool(corr >= cfg.min_correlation)
+        converged &= ok
+        results.append(
+            LsmResult(
+                float(params[j, 8]),
+                float(params[j, 9]),
+                float(math.sqrt(max(cov[0, 0], 0.0))),
+                float(math.sqrt(max(cov[1, 1], 0.0))),
+                cov,
+                corr,
+                it,
+                ok,
+                "" if ok else "low correlation",
+                np.array([[params[j, 0], params[j, 1], params[j, 8]], [params[j, 2], params[j, 3], params[j, 9]]]),
+                (float(params[j, 4]), float(params[j, 5])),
+                float(radiometry[j, 1]),
+                float(radiometry[j, 0]),
+                sigma0,
+            )
+        )
+    reason = "" if converged else "low correlation in " + ", ".join(
+        repr(v.name) for v, r in zip(views, results, strict=True) if not r.converged
+    )
+    return MgcmResult(X, covX, results, it, converged, reason, sigma0)
+
+
+def _mgcm_failed(X, nv: int, it: int, reason: str) -> MgcmResult:
+    nan = float("nan")
+    views = [_failed(nan, nan, it, reason) for _ in range(nv)]
+    return MgcmResult(np.asarray(X, dtype=np.float64).copy(), np.full((3, 3), np.nan), views, it, False, reason, nan)
