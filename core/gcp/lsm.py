@@ -79,7 +79,9 @@ class LsmConfig:
 
     def __post_init__(self) -> None:
         if not (isinstance(self.max_iterations, int) and self.max_iterations >= 1):
-            raise InputError(f"LsmConfig.max_iterations must be a positive integer, got {self.max_iterations!r}")
+            raise InputError(
+                f"LsmConfig.max_iterations must be a positive integer, got {self.max_iterations!r}"
+            )
         for name in ("tolerance", "max_shift"):
             v = getattr(self, name)
             if not (math.isfinite(v) and v > 0):
@@ -307,7 +309,9 @@ def _initial_params(x: float, y: float, initial) -> np.ndarray:
         if m.shape == (2, 3):
             m = np.vstack([m, [0.0, 0.0, 1.0]])
         if m.shape != (3, 3) or not np.all(np.isfinite(m)) or abs(m[2, 2]) < 1e-12:
-            raise InputError(f"initial: expected a (2, 3) affine or (3, 3) projective matrix, got {np.shape(initial)}")
+            raise InputError(
+                f"initial: expected a (2, 3) affine or (3, 3) projective matrix, got {np.shape(initial)}"
+            )
         m = m / m[2, 2]
         p[0], p[1], p[2], p[3] = m[0, 0], m[0, 1], m[1, 0], m[1, 1]
         p[4], p[5] = m[2, 0], m[2, 1]
@@ -316,7 +320,9 @@ def _initial_params(x: float, y: float, initial) -> np.ndarray:
 
 
 def _failed(x, y, it, reason, corr=float("nan")) -> LsmResult:
-    return LsmResult(float(x), float(y), float("nan"), float("nan"), np.full((2, 2), np.nan), corr, it, False, reason)
+    return LsmResult(
+        float(x), float(y), float("nan"), float("nan"), np.full((2, 2), np.nan), corr, it, False, reason
+    )
 
 
 #: Marquardt damping of the shaping parameters during the iterations: a rotationally symmetric
@@ -388,7 +394,9 @@ def _lsm_stage(t, window, ox, oy, p, r, cfg, start, it0):
             ssr, n, outside = _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
             if outside:
                 return pc, r, it, "left the image", None
-            sol = _solve(N[np.ix_(idx, idx)], b[idx]) or _solve(_damped(N[np.ix_(idx, idx)], shape_idx), b[idx])
+            sol = _solve(N[np.ix_(idx, idx)], b[idx]) or _solve(
+                _damped(N[np.ix_(idx, idx)], shape_idx), b[idx]
+            )
             if sol is None:
                 return pc, r, it, "singular (no texture)", None
             pc[8] += ox
@@ -397,7 +405,9 @@ def _lsm_stage(t, window, ox, oy, p, r, cfg, start, it0):
     return pc, r, it, "no convergence", None
 
 
-def lsm_match(template, image, x: float, y: float, config: LsmConfig | None = None, initial=None) -> LsmResult:
+def lsm_match(
+    template, image, x: float, y: float, config: LsmConfig | None = None, initial=None
+) -> LsmResult:
     """Match a template into an image by least squares from a start position.
 
     Parameters
@@ -498,7 +508,9 @@ def extract_template(image, x: float, y: float, half_size: int) -> np.ndarray:
     out = np.zeros((n, n))
     _normals(np.zeros((n, n)), img, img, img, p, 0.0, 1.0, np.zeros((10, 10)), np.zeros(10), out)
     if not np.all(np.isfinite(out)):
-        raise InputError(f"template at ({x:.1f}, {y:.1f}) with half size {half_size} reaches outside the image")
+        raise InputError(
+            f"template at ({x:.1f}, {y:.1f}) with half size {half_size} reaches outside the image"
+        )
     return out
 
 
@@ -740,11 +752,11 @@ def mgcm(
     covX = sigma0**2 * inv[:3, :3]
     results = []
     converged = True
-    for j, v in enumerate(views):
+    for j in range(nv):
         cov = jac[j] @ covX @ jac[j].T
         corr = _ncc(t, patches[j])
-        ok = bool(corr >= cfg.min_correlation)
-        converged &= ok
+        view_ok = bool(corr >= cfg.min_correlation)
+        converged = converged and view_ok
         results.append(
             LsmResult(
                 float(params[j, 8]),
@@ -754,17 +766,22 @@ def mgcm(
                 cov,
                 corr,
                 it,
-                ok,
-                "" if ok else "low correlation",
-                np.array([[params[j, 0], params[j, 1], params[j, 8]], [params[j, 2], params[j, 3], params[j, 9]]]),
+                view_ok,
+                "" if view_ok else "low correlation",
+                np.array(
+                    [[params[j, 0], params[j, 1], params[j, 8]], [params[j, 2], params[j, 3], params[j, 9]]]
+                ),
                 (float(params[j, 4]), float(params[j, 5])),
                 float(radiometry[j, 1]),
                 float(radiometry[j, 0]),
                 sigma0,
             )
         )
-    reason = "" if converged else "low correlation in " + ", ".join(
-        repr(v.name) for v, r in zip(views, results, strict=True) if not r.converged
+    reason = (
+        ""
+        if converged
+        else "low correlation in "
+        + ", ".join(repr(v.name) for v, r in zip(views, results, strict=True) if not r.converged)
     )
     return MgcmResult(X, covX, results, it, converged, reason, sigma0)
 
@@ -772,4 +789,6 @@ def mgcm(
 def _mgcm_failed(X, nv: int, it: int, reason: str) -> MgcmResult:
     nan = float("nan")
     views = [_failed(nan, nan, it, reason) for _ in range(nv)]
-    return MgcmResult(np.asarray(X, dtype=np.float64).copy(), np.full((3, 3), np.nan), views, it, False, reason, nan)
+    return MgcmResult(
+        np.asarray(X, dtype=np.float64).copy(), np.full((3, 3), np.nan), views, it, False, reason, nan
+    )

@@ -68,7 +68,8 @@ def _subpixels(shape, supersample: int) -> tuple[np.ndarray, np.ndarray]:
     o = (np.arange(s) + 0.5) / s - 0.5
     xs = (np.arange(w)[:, None] + o[None, :]).reshape(-1)
     ys = (np.arange(h)[:, None] + o[None, :]).reshape(-1)
-    return np.meshgrid(xs, ys)
+    gx, gy = np.meshgrid(xs, ys)
+    return gx, gy
 
 
 def render_homography(pattern, H, shape, supersample: int = 4, background: float | None = None) -> np.ndarray:
@@ -84,7 +85,11 @@ def render_homography(pattern, H, shape, supersample: int = 4, background: float
     Hm = np.asarray(H, dtype=np.float64)
     if pat.ndim != 2 or Hm.shape != (3, 3):
         raise InputError("render_homography: pattern must be 2-D and H 3x3")
-    bg = float(np.concatenate([pat[0], pat[-1], pat[:, 0], pat[:, -1]]).mean()) if background is None else background
+    bg = (
+        float(np.concatenate([pat[0], pat[-1], pat[:, 0], pat[:, -1]]).mean())
+        if background is None
+        else background
+    )
     X, Y = _subpixels(shape, supersample)
     Hi = np.linalg.inv(Hm)
     d = Hi[2, 0] * X + Hi[2, 1] * Y + Hi[2, 2]
@@ -129,7 +134,11 @@ def render_on_plane(
     (height, width) float64
     """
     pat = np.asarray(pattern, dtype=np.float64)
-    bg = float(np.concatenate([pat[0], pat[-1], pat[:, 0], pat[:, -1]]).mean()) if background is None else background
+    bg = (
+        float(np.concatenate([pat[0], pat[-1], pat[:, 0], pat[:, -1]]).mean())
+        if background is None
+        else background
+    )
     x0, y0, w, h = window if window is not None else (0, 0, camera.width, camera.height)
     X, Y = _subpixels((h, w), supersample)
     uv = np.column_stack([X.reshape(-1) + x0, Y.reshape(-1) + y0])

@@ -118,7 +118,9 @@ def test_mgcm_constrained_from_3px_off(block):
         xy = np.array([[v.x, v.y] for v in r.views])
         errs.append(np.hypot(*(xy - truth).T))
         for v, res in zip(views, r.views, strict=True):
-            np.testing.assert_allclose([res.x, res.y], project_points(r.X[None], v.R, v.C, v.camera)[0], atol=1e-9)
+            np.testing.assert_allclose(
+                [res.x, res.y], project_points(r.X[None], v.R, v.C, v.camera)[0], atol=1e-9
+            )
     assert float(np.sqrt(np.mean(np.square(errs)))) < 0.1
 
 
