@@ -79,101 +79,206 @@ def _to_camera(Rs, Cs, i, X):
     return p
 
 
+@njit
+def _ray_intersection(img, xy, Rs, Cs, s, e, dirs):
+    """Least-squares intersection of the viewing rays of one track.
+
+    Minimises the sum of squared perpendicular distances to the rays: with ``d_k`` the unit
+    direction of ray ``k`` and ``P_k = I - d_k d_k^T``, solves ``(sum P_k) X = sum P_k C_k``.
+
+    Parameters
+    ----------
+    img : (M,) int64
+        Image of every observation.
+    xy : (M, 2) float64
+        Normalised image coordinates ``(X/Z, Y/Z)`` of every observation.
+    Rs : (N, 3, 3) float64
+        World-to-camera rotations.
+    Cs : (N, 3) float64
+        Projection centres, local frame, metres.
+    s, e : int
+        The track's observations are ``s`` to ``e - 1`` (at least two).
+    dirs : (e - s, 3) float64
+        Output: unit ray directions ``R^T (x, y, 1) / |.|`` in the local frame.
+
+    Returns
+    -------
+    X : (3,) float64
+        The point, local frame, metres; NaN when the rays are (nearly) parallel.
+    """
+    A = np.zeros((3, 3))
+    b = np.zeros(3)
+    for k in range(e - s):
+        i = img[s + k]
+        # ray direction in the local frame: R^T (x, y, 1)
+        dx = Rs[i, 0, 0] * xy[s + k, 0] + Rs[i, 1, 0] * xy[s + k, 1] + Rs[i, 2, 0]
+        dy = Rs[i, 0, 1] * xy[s + k, 0] + Rs[i, 1, 1] * xy[s + k, 1] + Rs[i, 2, 1]
+        dz = Rs[i, 0, 2] * xy[s + k, 0] + Rs[i, 1, 2] * xy[s + k, 1] + Rs[i, 2, 2]
+        nrm = np.sqrt(dx * dx + dy * dy + dz * dz)
+        d0, d1, d2 = dx / nrm, dy / nrm, dz / nrm
+        dirs[k, 0], dirs[k, 1], dirs[k, 2] = d0, d1, d2
+        P = np.empty((3, 3))
+        P[0, 0] = 1 - d0 * d0
+        P[0, 1] = -d0 * d1
+        P[0, 2] = -d0 * d2
+        P[1, 0] = -d1 * d0
+        P[1, 1] = 1 - d1 * d1
+        P[1, 2] = -d1 * d2
+        P[2, 0] = -d2 * d0
+        P[2, 1] = -d2 * d1
+        P[2, 2] = 1 - d2 * d2
+        for r in range(3):
+            for c in range(3):
+                A[r, c] += P[r, c]
+            b[r] += P[r, 0] * Cs[i, 0] + P[r, 1] * Cs[i, 1] + P[r, 2] * Cs[i, 2]
+    X, _ = _solve3(A, b)
+    return X
+
+
+@njit
+def _largest_ray_angle(dirs):
+    """Largest angle between two of the unit rays ``dirs`` ((m, 3) float64), radians."""
+    m = dirs.shape[0]
+    mind = 1.0  # cos of the largest angle = the smallest dot product
+    for k in range(m):
+        for q in range(k + 1, m):
+            dd = dirs[k, 0] * dirs[q, 0] + dirs[k, 1] * dirs[q, 1] + dirs[k, 2] * dirs[q, 2]
+            if dd < mind:
+                mind = dd
+    return np.arccos(min(max(mind, -1.0), 1.0))
+
+
+@njit
+def _refine_point(img, xy, Rs, Cs, s, e, X, iterations):
+    """Gauss-Newton steps on the normalised reprojection error of one track's point, in place.
+
+    Minimises ``sum_k |pi(R_k (X - C_k)) - xy_k|^2`` with ``pi(p) = (p_x / p_z, p_y / p_z)``;
+    stops early when the point falls behind a camera or the normal equations are singular.
+
+    Parameters
+    ----------
+    img, xy, Rs, Cs, s, e
+        As for :func:`_ray_intersection`.
+    X : (3,) float64
+        The point, local frame, metres; updated in place.
+    iterations : int
+        Largest number of steps.
+    """
+    for _ in range(iterations):
+        H = np.zeros((3, 3))
+        g = np.zeros(3)
+        behind = False
+        for k in range(e - s):
+            i = img[s + k]
+            p = _to_camera(Rs, Cs, i, X)
+            if p[2] <= 0:
+                behind = True
+                break
+            iz = 1.0 / p[2]
+            rx = p[0] * iz - xy[s + k, 0]
+            ry = p[1] * iz - xy[s + k, 1]
+            for c in range(3):
+                jx = (Rs[i, 0, c] - p[0] * iz * Rs[i, 2, c]) * iz
+                jy = (Rs[i, 1, c] - p[1] * iz * Rs[i, 2, c]) * iz
+                g[c] += jx * rx + jy * ry
+                for c2 in range(3):
+                    jx2 = (Rs[i, 0, c2] - p[0] * iz * Rs[i, 2, c2]) * iz
+                    jy2 = (Rs[i, 1, c2] - p[1] * iz * Rs[i, 2, c2]) * iz
+                    H[c, c2] += jx * jx2 + jy * jy2
+        if behind:
+            break
+        step, _ = _solve3(H, g)
+        if not np.isfinite(step[0]):
+            break
+        X[0] -= step[0]
+        X[1] -= step[1]
+        X[2] -= step[2]
+
+
+@njit
+def _largest_reprojection_error(img, xy, Rs, Cs, scale, s, e, X):
+    """Largest reprojection error of a track's point and whether every camera sees it in front.
+
+    Parameters
+    ----------
+    img, xy, Rs, Cs, s, e
+        As for :func:`_ray_intersection`.
+    scale : (N,) float64
+        Per image, multiplies normalised errors into the reported unit (pixels with the focal
+        length).
+    X : (3,) float64
+        The point, local frame, metres.
+
+    Returns
+    -------
+    worst : float
+        Largest error over the observations, in ``scale`` units (of those checked before a
+        camera saw the point behind it).
+    in_front : bool
+        False when the point lies behind (or in the plane of) a camera.
+    """
+    worst = 0.0
+    for k in range(e - s):
+        i = img[s + k]
+        p = _to_camera(Rs, Cs, i, X)
+        if p[2] <= 0:
+            return worst, False
+        ex = (p[0] / p[2] - xy[s + k, 0]) * scale[i]
+        ey = (p[1] / p[2] - xy[s + k, 1]) * scale[i]
+        err = np.sqrt(ex * ex + ey * ey)
+        if err > worst:
+            worst = err
+    return worst, True
+
+
 @pjit
 def _triangulate(offsets, img, xy, Rs, Cs, scale, iterations, out, angle, max_err, ok):
+    """Triangulate every track (parallel over tracks): rays -> point -> refinement -> checks.
+
+    Parameters
+    ----------
+    offsets : (T + 1,) int64
+        CSR offsets of the tracks into the observations.
+    img : (M,) int64
+        Image of every observation (index into ``Rs``, ``Cs``, ``scale``).
+    xy : (M, 2) float64
+        Undistorted normalised image coordinates of the observations.
+    Rs : (N, 3, 3) float64
+        World-to-camera rotations.
+    Cs : (N, 3) float64
+        Projection centres, local frame, metres.
+    scale : (N,) float64
+        Normalised error -> reported unit (pixels with the focal length).
+    iterations : int
+        Gauss-Newton steps per point.
+    out : (T, 3) float64
+        Output: points, local frame, metres (NaN where the rays do not intersect).
+    angle : (T,) float64
+        Output: largest intersection angle, radians (0 for tracks of fewer than two rays).
+    max_err : (T,) float64
+        Output: largest reprojection error, ``scale`` units (inf where not triangulated).
+    ok : (T,) bool
+        Output: triangulated, in front of every camera, finite error.
+    """
     n_tracks = offsets.shape[0] - 1
     for t in prange(n_tracks):
         s, e = offsets[t], offsets[t + 1]
-        m = e - s
         ok[t] = False
         angle[t] = 0.0
         max_err[t] = np.inf
         out[t, :] = np.nan
-        if m < 2:
+        if e - s < 2:
             continue
-        A = np.zeros((3, 3))
-        b = np.zeros(3)
-        dirs = np.empty((m, 3))
-        for k in range(m):
-            i = img[s + k]
-            # ray direction in the local frame: R^T (x, y, 1)
-            dx = Rs[i, 0, 0] * xy[s + k, 0] + Rs[i, 1, 0] * xy[s + k, 1] + Rs[i, 2, 0]
-            dy = Rs[i, 0, 1] * xy[s + k, 0] + Rs[i, 1, 1] * xy[s + k, 1] + Rs[i, 2, 1]
-            dz = Rs[i, 0, 2] * xy[s + k, 0] + Rs[i, 1, 2] * xy[s + k, 1] + Rs[i, 2, 2]
-            nrm = np.sqrt(dx * dx + dy * dy + dz * dz)
-            d0, d1, d2 = dx / nrm, dy / nrm, dz / nrm
-            dirs[k, 0], dirs[k, 1], dirs[k, 2] = d0, d1, d2
-            P = np.empty((3, 3))
-            P[0, 0] = 1 - d0 * d0
-            P[0, 1] = -d0 * d1
-            P[0, 2] = -d0 * d2
-            P[1, 0] = -d1 * d0
-            P[1, 1] = 1 - d1 * d1
-            P[1, 2] = -d1 * d2
-            P[2, 0] = -d2 * d0
-            P[2, 1] = -d2 * d1
-            P[2, 2] = 1 - d2 * d2
-            for r in range(3):
-                for c in range(3):
-                    A[r, c] += P[r, c]
-                b[r] += P[r, 0] * Cs[i, 0] + P[r, 1] * Cs[i, 1] + P[r, 2] * Cs[i, 2]
-        X, det = _solve3(A, b)
+        dirs = np.empty((e - s, 3))
+        X = _ray_intersection(img, xy, Rs, Cs, s, e, dirs)
         if not np.isfinite(X[0]):
             continue
-        # largest pairwise angle (cos of the smallest dot product)
-        mind = 1.0
-        for k in range(m):
-            for q in range(k + 1, m):
-                dd = dirs[k, 0] * dirs[q, 0] + dirs[k, 1] * dirs[q, 1] + dirs[k, 2] * dirs[q, 2]
-                if dd < mind:
-                    mind = dd
-        angle[t] = np.arccos(min(max(mind, -1.0), 1.0))
-        # Gauss-Newton on normalised reprojection error
-        for _ in range(iterations):
-            H = np.zeros((3, 3))
-            g = np.zeros(3)
-            behind = False
-            for k in range(m):
-                i = img[s + k]
-                p = _to_camera(Rs, Cs, i, X)
-                if p[2] <= 0:
-                    behind = True
-                    break
-                iz = 1.0 / p[2]
-                rx = p[0] * iz - xy[s + k, 0]
-                ry = p[1] * iz - xy[s + k, 1]
-                for c in range(3):
-                    jx = (Rs[i, 0, c] - p[0] * iz * Rs[i, 2, c]) * iz
-                    jy = (Rs[i, 1, c] - p[1] * iz * Rs[i, 2, c]) * iz
-                    g[c] += jx * rx + jy * ry
-                    for c2 in range(3):
-                        jx2 = (Rs[i, 0, c2] - p[0] * iz * Rs[i, 2, c2]) * iz
-                        jy2 = (Rs[i, 1, c2] - p[1] * iz * Rs[i, 2, c2]) * iz
-                        H[c, c2] += jx * jx2 + jy * jy2
-            if behind:
-                break
-            step, det = _solve3(H, g)
-            if not np.isfinite(step[0]):
-                break
-            X[0] -= step[0]
-            X[1] -= step[1]
-            X[2] -= step[2]
-        worst = 0.0
-        good = True
-        for k in range(m):
-            i = img[s + k]
-            p = _to_camera(Rs, Cs, i, X)
-            if p[2] <= 0:
-                good = False
-                break
-            ex = (p[0] / p[2] - xy[s + k, 0]) * scale[i]
-            ey = (p[1] / p[2] - xy[s + k, 1]) * scale[i]
-            err = np.sqrt(ex * ex + ey * ey)
-            if err > worst:
-                worst = err
+        angle[t] = _largest_ray_angle(dirs)
+        _refine_point(img, xy, Rs, Cs, s, e, X, iterations)
+        worst, in_front = _largest_reprojection_error(img, xy, Rs, Cs, scale, s, e, X)
         out[t, 0], out[t, 1], out[t, 2] = X[0], X[1], X[2]
         max_err[t] = worst
-        ok[t] = good and np.isfinite(worst)
+        ok[t] = in_front and np.isfinite(worst)
 
 
 def triangulate_tracks(

@@ -339,8 +339,26 @@ def _inside(u, v, u0, v0, u1, v1, u2, v2):
 
 
 @njit
-def _vh(grp, hgt, i, j, r, c):
-    """Height of the vertex of cell (r, c) at lattice corner (i, j)."""
+def _corner_height(grp, hgt, i, j, r, c):
+    """Height of the vertex that cell (r, c) uses at lattice corner (i, j).
+
+    Parameters
+    ----------
+    grp : (rows + 1, cols + 1, 4) int8
+        Group of each of the four cells around every corner (:func:`_corner_groups`).
+    hgt : (rows + 1, cols + 1, 4) float64
+        Height of each group at every corner, metres.
+    i, j : int
+        Lattice corner (row, column); corner (i, j) is the top-left corner of cell (i, j).
+    r, c : int
+        One of the four cells around the corner (``r`` in ``i - 1, i``, ``c`` in ``j - 1, j``).
+
+    Returns
+    -------
+    float
+        Height of the corner's vertex in the group of cell (r, c), metres (NaN if that cell
+        is invalid).
+    """
     p = 2 * (r - i + 1) + (c - j + 1)
     return hgt[i, j, grp[i, j, p]]
 
@@ -349,15 +367,15 @@ def _vh(grp, hgt, i, j, r, c):
 def _block_error(z, grp, hgt, r0, c0, s):
     """Largest error over the block's cells of every triangulation the block may receive."""
     h = s // 2
-    tl = _vh(grp, hgt, r0, c0, r0, c0)
-    tr = _vh(grp, hgt, r0, c0 + s, r0, c0 + s - 1)
-    bl = _vh(grp, hgt, r0 + s, c0, r0 + s - 1, c0)
-    br = _vh(grp, hgt, r0 + s, c0 + s, r0 + s - 1, c0 + s - 1)
-    mt = _vh(grp, hgt, r0, c0 + h, r0, c0 + h)
-    mb = _vh(grp, hgt, r0 + s, c0 + h, r0 + s - 1, c0 + h)
-    ml = _vh(grp, hgt, r0 + h, c0, r0 + h, c0)
-    mr = _vh(grp, hgt, r0 + h, c0 + s, r0 + h, c0 + s - 1)
-    cc = _vh(grp, hgt, r0 + h, c0 + h, r0 + h, c0 + h)
+    tl = _corner_height(grp, hgt, r0, c0, r0, c0)
+    tr = _corner_height(grp, hgt, r0, c0 + s, r0, c0 + s - 1)
+    bl = _corner_height(grp, hgt, r0 + s, c0, r0 + s - 1, c0)
+    br = _corner_height(grp, hgt, r0 + s, c0 + s, r0 + s - 1, c0 + s - 1)
+    mt = _corner_height(grp, hgt, r0, c0 + h, r0, c0 + h)
+    mb = _corner_height(grp, hgt, r0 + s, c0 + h, r0 + s - 1, c0 + h)
+    ml = _corner_height(grp, hgt, r0 + h, c0, r0 + h, c0)
+    mr = _corner_height(grp, hgt, r0 + h, c0 + s, r0 + h, c0 + s - 1)
+    cc = _corner_height(grp, hgt, r0 + h, c0 + h, r0 + h, c0 + h)
     worst = 0.0
     for r in range(r0, r0 + s):
         for c in range(c0, c0 + s):
@@ -558,8 +576,32 @@ def _convex_cell(sr, sc, r, c):
 
 
 @njit
-def _put(out_k, out_v, nv, key, li, lj, z, col, i, j, q, has_rgb):
-    """One vertex record: key, lattice row/col (world position), height, colour of group q at (i, j)."""
+def _put_vertex(out_k, out_v, nv, key, li, lj, z, col, i, j, q, has_rgb):
+    """Append one vertex record at index ``nv``; returns ``nv + 1``.
+
+    Parameters
+    ----------
+    out_k : (V,) int64
+        Vertex keys (see :func:`_emit`); ``out_k[nv]`` is written.
+    out_v : (V, 6) float64
+        Vertex records: lattice row, lattice column, height (metres), red, green, blue (0-255);
+        row ``nv`` is written (the colour only when ``has_rgb``).
+    nv : int
+        Index of the record to write.
+    key : int
+        Key of the vertex.
+    li, lj : float
+        Lattice row and column of the vertex (cells, fractional for chamfered corners and
+        cell centres), in the global grid.
+    z : float
+        Height, metres.
+    col : (rows + 1, cols + 1, 4, 3) float32
+        Colour of every group at every corner (:func:`_corner_groups`).
+    i, j, q : int
+        Corner (tile lattice) and group whose colour the vertex takes.
+    has_rgb : bool
+        Whether ``col`` holds colours.
+    """
     out_k[nv] = key
     out_v[nv, 0] = li
     out_v[nv, 1] = lj
@@ -572,8 +614,28 @@ def _put(out_k, out_v, nv, key, li, lj, z, col, i, j, q, has_rgb):
 
 
 @njit
-def _count(z, lev, jh, jv, core):
-    """Upper bounds of the faces and vertex records :func:`_emit` writes for a tile core."""
+def _tile_capacity(z, lev, jh, jv, core):
+    """Upper bounds of the faces and vertex records :func:`_emit` writes for a tile core.
+
+    Parameters
+    ----------
+    z : (rows, cols) float64
+        Heights of the tile window, metres; NaN = nodata.
+    lev : (rows, cols) int8
+        Quadtree level of every cell after balancing (leaf side ``2^level``; -1 = nodata).
+    jh : (rows, cols - 1) bool
+        Joined horizontal edges (:func:`_joins`).
+    jv : (rows - 1, cols) bool
+        Joined vertical edges.
+    core : (4,) int64
+        Core of the tile in window cells: first row, first column, end row, end column.
+
+    Returns
+    -------
+    faces, vertices : int
+        At most 4 faces and 5 vertex records per single cell, 8 and 9 per larger leaf (a fan
+        with its four edge midpoints), 2 and 4 per wall edge.
+    """
     nr, nc = z.shape
     nf = 0
     nv = 0
@@ -595,8 +657,24 @@ def _count(z, lev, jh, jv, core):
 
 
 @njit
-def _finer(lev, ra, ca, rb, cb, k):
-    """Whether either of two cells (one per half of a leaf edge) lies in a leaf finer than level k."""
+def _finer_neighbour(lev, ra, ca, rb, cb, k):
+    """Whether a leaf edge needs its midpoint: a neighbour across it is a finer leaf.
+
+    Parameters
+    ----------
+    lev : (rows, cols) int8
+        Quadtree level of every cell (leaf side ``2^level``; -1 = nodata).
+    ra, ca, rb, cb : int
+        The two neighbouring cells across the edge, one per half of the edge; cells outside the
+        window count as not finer.
+    k : int
+        Level of the leaf.
+
+    Returns
+    -------
+    bool
+        True when either cell is valid and of a level below ``k``.
+    """
     nr, nc = lev.shape
     for r, c in ((ra, ca), (rb, cb)):
         if 0 <= r < nr and 0 <= c < nc and 0 <= lev[r, c] < k:
@@ -662,22 +740,22 @@ def _emit(
             cnt = 0
             ii[cnt], jj[cnt], rr[cnt], cc_[cnt] = r, c, r, c
             cnt += 1
-            if k >= 1 and _finer(lev, r - 1, c, r - 1, c + h, k):
+            if k >= 1 and _finer_neighbour(lev, r - 1, c, r - 1, c + h, k):
                 ii[cnt], jj[cnt], rr[cnt], cc_[cnt] = r, c + h, r, c + h
                 cnt += 1
             ii[cnt], jj[cnt], rr[cnt], cc_[cnt] = r, c + s, r, c + s - 1
             cnt += 1
-            if k >= 1 and _finer(lev, r, c + s, r + h, c + s, k):
+            if k >= 1 and _finer_neighbour(lev, r, c + s, r + h, c + s, k):
                 ii[cnt], jj[cnt], rr[cnt], cc_[cnt] = r + h, c + s, r + h, c + s - 1
                 cnt += 1
             ii[cnt], jj[cnt], rr[cnt], cc_[cnt] = r + s, c + s, r + s - 1, c + s - 1
             cnt += 1
-            if k >= 1 and _finer(lev, r + s, c, r + s, c + h, k):
+            if k >= 1 and _finer_neighbour(lev, r + s, c, r + s, c + h, k):
                 ii[cnt], jj[cnt], rr[cnt], cc_[cnt] = r + s, c + h, r + s - 1, c + h
                 cnt += 1
             ii[cnt], jj[cnt], rr[cnt], cc_[cnt] = r + s, c, r + s - 1, c
             cnt += 1
-            if k >= 1 and _finer(lev, r, c - 1, r + h, c - 1, k):
+            if k >= 1 and _finer_neighbour(lev, r, c - 1, r + h, c - 1, k):
                 ii[cnt], jj[cnt], rr[cnt], cc_[cnt] = r + h, c, r + h, c
                 cnt += 1
             for t in range(cnt):
@@ -686,7 +764,7 @@ def _emit(
                 p = 2 * (rr[t] - i + 1) + (cc_[t] - j + 1)
                 q = grp[i, j, p]
                 keys[t] = ((gr0 + i) * (gcols + 1) + (gc0 + j)) * 4 + q
-                nv = _put(
+                nv = _put_vertex(
                     out_k,
                     out_v,
                     nv,
@@ -707,7 +785,9 @@ def _emit(
                 j = c + h
                 q = grp[i, j, 3]
                 centre = ((gr0 + i) * (gcols + 1) + (gc0 + j)) * 4 + q
-                nv = _put(out_k, out_v, nv, centre, gr0 + i, gc0 + j, hgt[i, j, q], col, i, j, q, has_rgb)
+                nv = _put_vertex(
+                    out_k, out_v, nv, centre, gr0 + i, gc0 + j, hgt[i, j, q], col, i, j, q, has_rgb
+                )
             elif k == 0:
                 # a single cell: the better diagonal, or a centre vertex with the cell's height
                 zz = z[r, c]
@@ -796,7 +876,7 @@ def _emit(
                     j = ijp[1]
                     q = grp[i, j, ijp[2]]
                     ks[t] = ((gr0 + i) * (gcols + 1) + (gc0 + j)) * 4 + q
-                    nv = _put(
+                    nv = _put_vertex(
                         out_k,
                         out_v,
                         nv,
@@ -899,7 +979,7 @@ def _mesh_tiles(
             if cnt:
                 leaves[s] = leaves.get(s, 0) + cnt
         core = np.array([margin, margin, margin + nr, margin + nc], np.int64)
-        cap_f, cap_v = _count(z, lev, jh, jv, core)
+        cap_f, cap_v = _tile_capacity(z, lev, jh, jv, core)
         out_f = np.zeros((cap_f, 3), np.int64)
         out_w = np.zeros((cap_f, 2), np.int8)
         out_k = np.zeros(cap_v, np.int64)
