@@ -59,6 +59,8 @@ class TruOrthoPlugin:
         self.translator: QTranslator | None = None
         self.actions: list[QAction] = []
         self.toolbar = None
+        self.gcp_action: QAction | None = None
+        self.gcp_panel = None
         self.install_translator()
 
     # ------------------------------------------------------------ translations
@@ -100,6 +102,26 @@ class TruOrthoPlugin:
             self.iface.addPluginToRasterMenu(tr(MENU), action)
             self.actions.append(action)
         self.toolbar.addAction(self.actions[0])
+        self.gcp_action = QAction(icon, tr("GCP measurements in photos…"), parent)
+        self.gcp_action.setObjectName("truortho_gcp_panel")
+        self.gcp_action.setCheckable(True)
+        self.gcp_action.toggled.connect(self.show_gcp_panel)
+        self.iface.addPluginToRasterMenu(tr(MENU), self.gcp_action)
+
+    def show_gcp_panel(self, visible: bool = True):
+        """Show (create on first use) or hide the GCP measurement dock."""
+        from qgis.PyQt.QtCore import Qt
+
+        if self.gcp_panel is None and visible:
+            from .gcp_panel import GcpPanel
+
+            self.gcp_panel = GcpPanel(self.iface, self.iface.mainWindow())
+            self.iface.addDockWidget(Qt.RightDockWidgetArea, self.gcp_panel)
+            if self.gcp_action is not None:
+                self.gcp_panel.visibilityChanged.connect(self.gcp_action.setChecked)
+        if self.gcp_panel is not None:
+            self.gcp_panel.setVisible(visible)
+        return self.gcp_panel
 
     def open_dialog(self, alg_id: str):
         """Open the Processing dialog of an algorithm (results load into the project as layers)."""
@@ -129,6 +151,17 @@ class TruOrthoPlugin:
                 self.iface.removePluginRasterMenu(tr(MENU), action)
             action.deleteLater()
         self.actions = []
+        if self.gcp_panel is not None:
+            if self.iface is not None:
+                self.iface.removeDockWidget(self.gcp_panel)
+            self.gcp_panel.close()
+            self.gcp_panel.deleteLater()
+            self.gcp_panel = None
+        if self.gcp_action is not None:
+            if self.iface is not None:
+                self.iface.removePluginRasterMenu(tr(MENU), self.gcp_action)
+            self.gcp_action.deleteLater()
+            self.gcp_action = None
         if self.toolbar is not None:
             self.toolbar.deleteLater()
             self.toolbar = None
