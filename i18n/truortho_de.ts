@@ -4,57 +4,57 @@
     <context>
         <name>TruOrtho</name>
         <message>
-            <location filename="../processing/algorithms/base.py" line="16" />
+            <location filename="../processing/algorithms/base.py" line="20" />
             <source>Orientation</source>
             <translation>Orientierung</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="16" />
+            <location filename="../processing/algorithms/base.py" line="20" />
             <source>Orthophoto</source>
             <translation>Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="16" />
+            <location filename="../processing/algorithms/base.py" line="20" />
             <source>Surface</source>
             <translation>Oberfläche</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="16" />
+            <location filename="../processing/algorithms/base.py" line="20" />
             <source>Tools</source>
             <translation>Werkzeuge</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="71" />
+            <location filename="../processing/algorithms/base.py" line="145" />
             <source>Run tiles on</source>
             <translation>Kacheln ausführen auf</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="84" />
+            <location filename="../processing/algorithms/base.py" line="158" />
             <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
             <translation>Adresse des Dask-Schedulers (tls://host:port oder Scheduler-Datei; leer = TRUORTHO_DASK_SCHEDULER)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="104" />
+            <location filename="../processing/algorithms/base.py" line="178" />
             <source>Ground control points</source>
             <translation>Passpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="110" />
+            <location filename="../processing/algorithms/base.py" line="184" />
             <source>GCP image measurements (table)</source>
             <translation>Bildmessungen der Passpunkte (Tabelle)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="73" />
+            <location filename="../processing/algorithms/base.py" line="147" />
             <source>inprocess: this process (all cores)</source>
             <translation>inprocess: dieser Prozess (alle Kerne)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="74" />
+            <location filename="../processing/algorithms/base.py" line="148" />
             <source>local: a Dask cluster of worker processes on this computer</source>
             <translation>local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="75" />
+            <location filename="../processing/algorithms/base.py" line="149" />
             <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
             <translation>scheduler: ein Dask-Scheduler (SCHEDULER_ADDRESS)</translation>
         </message>
@@ -64,132 +64,132 @@
             <translation>DOM filtern (Ausreißer, Lücken, Glättung, DGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="255" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="320" />
             <source>Filtered DSM</source>
             <translation>Gefiltertes DOM</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="64" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="81" />
             <source>Raw DSM</source>
             <translation>Rohes DOM</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="66" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="83" />
             <source>Confidence raster [0, 1]</source>
             <translation>Konfidenzraster [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="71" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="88" />
             <source>Outlier threshold (m; empty = 4 x resolution)</source>
             <translation>Ausreißerschwelle (m; leer = 4 x Auflösung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="78" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="98" />
             <source>Largest hole width filled (m)</source>
             <translation>Größte gefüllte Lückenbreite (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="79" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="106" />
             <source>Sharpen blurred height steps</source>
             <translation>Verschliffene Höhensprünge schärfen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="82" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="111" />
             <source>Edge-preserving smoothing of planar surfaces</source>
             <translation>Kantenerhaltende Glättung ebener Flächen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="88" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="117" />
             <source>Outlier window (cells, odd)</source>
             <translation>Ausreißerfenster (Zellen, ungerade)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="97" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="128" />
             <source>Supporting neighbours that keep a cell</source>
             <translation>Stützende Nachbarn, die eine Zelle erhalten</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="101" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="138" />
             <source>Minimum confidence</source>
             <translation>Mindestkonfidenz</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="107" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="149" />
             <source>Confident cells (confidence at least)</source>
             <translation>Zuverlässige Zellen (Konfidenz mindestens)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="116" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="160" />
             <source>Height step between surfaces (m)</source>
             <translation>Höhensprung zwischen Oberflächen (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="120" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="170" />
             <source>Smoothing radius (cells)</source>
             <translation>Glättungsradius (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="126" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="181" />
             <source>Smoothing height tolerance (m; empty = 2.5 x resolution)</source>
             <translation>Höhentoleranz der Glättung (m; leer = 2,5 x Auflösung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="137" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="192" />
             <source>Ground filter cell size (m; empty = max(1 m, resolution))</source>
             <translation>Zellgröße des Bodenfilters (m; leer = max(1 m, Auflösung))</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="146" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="203" />
             <source>Ground filter window radius (m)</source>
             <translation>Fensterradius des Bodenfilters (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="150" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="213" />
             <source>Ground filter slope (rise/run)</source>
             <translation>Neigung des Bodenfilters (Höhe/Strecke)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="157" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="224" />
             <source>Terrain model (DTM)</source>
             <translation>Geländemodell (DGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="229" />
             <source>Normalised DSM (height above terrain)</source>
             <translation>Normalisiertes DOM (Höhe über Gelände)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="165" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="232" />
             <source>Statistics (JSON)</source>
             <translation>Statistik (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="166" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="233" />
             <source>Outliers removed (cells)</source>
             <translation>Entfernte Ausreißer (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="167" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="234" />
             <source>Hole cells filled</source>
             <translation>Gefüllte Lückenzellen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="168" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="235" />
             <source>Holes left as nodata</source>
             <translation>Als NoData verbliebene Lücken</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="257" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="322" />
             <source>DTM</source>
             <translation>DGM</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="217" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="282" />
             <source>{} holes ({} cells, widest {:.1f} m) are wider than {} m and stay nodata</source>
             <translation>{} Lücken ({} Zellen, breiteste {:.1f} m) sind breiter als {} m und bleiben NoData</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="245" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="310" />
             <source>Ground filter at {:.2f} m: {:.1f} % of the cells are ground</source>
             <translation>Bodenfilter mit {:.2f} m: {:.1f} % der Zellen sind Boden</translation>
         </message>
@@ -239,37 +239,37 @@
             <translation>Orientierung exportieren</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="30" />
+            <location filename="../processing/algorithms/exportorientation.py" line="32" />
             <source>Orientation (TruOrtho JSON)</source>
             <translation>Orientierung (TruOrtho-JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="34" />
+            <location filename="../processing/algorithms/exportorientation.py" line="36" />
             <source>Format</source>
             <translation>Format</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="39" />
+            <location filename="../processing/algorithms/exportorientation.py" line="41" />
             <source>Output folder</source>
             <translation>Ausgabeordner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="40" />
+            <location filename="../processing/algorithms/exportorientation.py" line="42" />
             <source>Files written</source>
             <translation>Geschriebene Dateien</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="35" />
+            <location filename="../processing/algorithms/exportorientation.py" line="37" />
             <source>COLMAP text model</source>
             <translation>COLMAP-Textmodell</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="35" />
+            <location filename="../processing/algorithms/exportorientation.py" line="37" />
             <source>Orthority OPK CSV + interior file</source>
             <translation>Orthority-OPK-CSV + Datei der inneren Orientierung</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="52" />
+            <location filename="../processing/algorithms/exportorientation.py" line="54" />
             <source>Wrote {}</source>
             <translation>{} geschrieben</translation>
         </message>
@@ -279,42 +279,42 @@
             <translation>Passpunktliste importieren</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="38" />
+            <location filename="../processing/algorithms/importgcps.py" line="44" />
             <source>GCP list (ODM gcp_list.txt)</source>
             <translation>Passpunktliste (ODM gcp_list.txt)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="41" />
+            <location filename="../processing/algorithms/importgcps.py" line="47" />
             <source>Check point names (comma-separated)</source>
             <translation>Namen der Kontrollpunkte (kommagetrennt)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="47" />
+            <location filename="../processing/algorithms/importgcps.py" line="53" />
             <source>Default sigma XY [m]</source>
             <translation>Standard-Sigma XY [m]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="56" />
+            <location filename="../processing/algorithms/importgcps.py" line="62" />
             <source>Default sigma Z [m]</source>
             <translation>Standard-Sigma Z [m]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="62" />
+            <location filename="../processing/algorithms/importgcps.py" line="68" />
             <source>Reproject to CRS</source>
             <translation>In KBS umprojizieren</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="70" />
+            <location filename="../processing/algorithms/importgcps.py" line="76" />
             <source>GCP image measurements</source>
             <translation>Bildmessungen der Passpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="123" />
+            <location filename="../processing/algorithms/importgcps.py" line="129" />
             <source>{} GCPs ({} check points), {} image measurements</source>
             <translation>{} Passpunkte ({} Kontrollpunkte), {} Bildmessungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="97" />
+            <location filename="../processing/algorithms/importgcps.py" line="103" />
             <source>CHECK_POINTS: unknown GCP name(s) {}; the file has {}</source>
             <translation>CHECK_POINTS: unbekannte(r) Passpunktname(n) {}; die Datei enthält {}</translation>
         </message>
@@ -324,77 +324,77 @@
             <translation>Orientierung importieren</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="60" />
+            <location filename="../processing/algorithms/importorientation.py" line="62" />
             <source>Orientation file (COLMAP, Orthority CSV, OpenSfM)</source>
             <translation>Orientierungsdatei (COLMAP, Orthority-CSV, OpenSfM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="64" />
+            <location filename="../processing/algorithms/importorientation.py" line="66" />
             <source>Interior parameter file (Orthority)</source>
             <translation>Parameterdatei der inneren Orientierung (Orthority)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="69" />
+            <location filename="../processing/algorithms/importorientation.py" line="71" />
             <source>CRS of the input (when the file has none)</source>
             <translation>KBS der Eingabe (wenn die Datei keins angibt)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="75" />
+            <location filename="../processing/algorithms/importorientation.py" line="77" />
             <source>Image folder</source>
             <translation>Bildordner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="84" />
+            <location filename="../processing/algorithms/importorientation.py" line="86" />
             <source>Footprint height</source>
             <translation>Höhe der Bildabdeckungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="91" />
+            <location filename="../processing/algorithms/importorientation.py" line="93" />
             <source>Orientation (JSON)</source>
             <translation>Orientierung (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="95" />
+            <location filename="../processing/algorithms/importorientation.py" line="97" />
             <source>Cameras</source>
             <translation>Kameras</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="99" />
+            <location filename="../processing/algorithms/importorientation.py" line="101" />
             <source>Footprints</source>
             <translation>Bildabdeckungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="125" />
+            <location filename="../processing/algorithms/importorientation.py" line="127" />
             <source>The orientation has no CRS: it stays in its arbitrary (local) frame. Give CRS (or a georef.json) to georeference it.</source>
             <translation>Die Orientierung hat kein KBS: sie bleibt in ihrem beliebigen (lokalen) System. Geben Sie CRS (oder eine georef.json) an, um sie zu georeferenzieren.</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="141" />
+            <location filename="../processing/algorithms/importorientation.py" line="143" />
             <source>OBSERVATIONS given without a GCPS layer</source>
             <translation>OBSERVATIONS ohne GCPS-Layer angegeben</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="115" />
+            <location filename="../processing/algorithms/importorientation.py" line="117" />
             <source>Read {} images, {} cameras, {} sparse points</source>
             <translation>{} Bilder, {} Kameras, {} Punkte der dünnen Punktwolke gelesen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="145" />
+            <location filename="../processing/algorithms/importorientation.py" line="147" />
             <source>GCPs need a georeferenced orientation: give CRS for the input</source>
             <translation>Passpunkte erfordern eine georeferenzierte Orientierung: geben Sie CRS für die Eingabe an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="122" />
+            <location filename="../processing/algorithms/importorientation.py" line="124" />
             <source>{}: the orientation contains no images</source>
             <translation>{}: die Orientierung enthält keine Bilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="151" />
+            <location filename="../processing/algorithms/importorientation.py" line="153" />
             <source>{} GCPs with {} image measurements</source>
             <translation>{} Passpunkte mit {} Bildmessungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="187" />
+            <location filename="../processing/algorithms/importorientation.py" line="189" />
             <source>Image {} does not see the plane at height {}</source>
             <translation>Bild {} sieht die Ebene in Höhe {} nicht</translation>
         </message>
@@ -404,102 +404,102 @@
             <translation>Vermaschung aus DOM oder Punktwolke</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="50" />
+            <location filename="../processing/algorithms/mesh.py" line="61" />
             <source>DSM raster or point cloud (LAS/LAZ, EPT ept.json)</source>
             <translation>DOM-Raster oder Punktwolke (LAS/LAZ, EPT ept.json)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="55" />
+            <location filename="../processing/algorithms/mesh.py" line="66" />
             <source>Orthoimage for vertex colours</source>
             <translation>Orthobild für die Eckpunktfarben</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="60" />
+            <location filename="../processing/algorithms/mesh.py" line="71" />
             <source>Largest vertical error (m; empty = half the DSM resolution)</source>
             <translation>Größter Höhenfehler (m; leer = halbe DOM-Auflösung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="68" />
+            <location filename="../processing/algorithms/mesh.py" line="81" />
             <source>Smallest height step made a wall (m)</source>
             <translation>Kleinster Höhensprung, der zur Wand wird (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="73" />
+            <location filename="../processing/algorithms/mesh.py" line="90" />
             <source>Steepest slope kept as a surface (degrees)</source>
             <translation>Steilste als Fläche erhaltene Neigung (Grad)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="84" />
+            <location filename="../processing/algorithms/mesh.py" line="101" />
             <source>Largest flat block (cells, power of two)</source>
             <translation>Größter ebener Block (Zellen, Zweierpotenz)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="95" />
+            <location filename="../processing/algorithms/mesh.py" line="112" />
             <source>Point clouds: longest triangle edge (m; empty = automatic)</source>
             <translation>Punktwolken: längste Dreieckskante (m; leer = automatisch)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="106" />
+            <location filename="../processing/algorithms/mesh.py" line="123" />
             <source>Coordinates</source>
             <translation>Koordinaten</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="113" />
+            <location filename="../processing/algorithms/mesh.py" line="130" />
             <source>Mesh</source>
             <translation>Dreiecksnetz</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="113" />
+            <location filename="../processing/algorithms/mesh.py" line="130" />
             <source>PLY mesh (*.ply);;Wavefront OBJ (*.obj)</source>
             <translation>PLY-Netz (*.ply);;Wavefront OBJ (*.obj)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="116" />
+            <location filename="../processing/algorithms/mesh.py" line="133" />
             <source>Vertices</source>
             <translation>Eckpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="117" />
+            <location filename="../processing/algorithms/mesh.py" line="134" />
             <source>Faces</source>
             <translation>Dreiecke</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="118" />
+            <location filename="../processing/algorithms/mesh.py" line="135" />
             <source>Wall faces</source>
             <translation>Wanddreiecke</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="51" />
+            <location filename="../processing/algorithms/mesh.py" line="62" />
             <source>DSM or point cloud (*.tif *.tiff *.las *.laz *.json);;All files (*.*)</source>
             <translation>DOM oder Punktwolke (*.tif *.tiff *.las *.laz *.json);;Alle Dateien (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="107" />
+            <location filename="../processing/algorithms/mesh.py" line="124" />
             <source>CRS (world coordinates)</source>
             <translation>KBS (Weltkoordinaten)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="107" />
+            <location filename="../processing/algorithms/mesh.py" line="124" />
             <source>Local frame (world - offset, offset in the header)</source>
             <translation>Lokales System (Welt - Offset, Offset im Dateikopf)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="138" />
+            <location filename="../processing/algorithms/mesh.py" line="155" />
             <source>ORTHO is ignored for point clouds (their own colours are used)</source>
             <translation>ORTHO wird bei Punktwolken ignoriert (ihre eigenen Farben werden verwendet)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="128" />
+            <location filename="../processing/algorithms/mesh.py" line="145" />
             <source>INPUT: file not found: {}</source>
             <translation>INPUT: Datei nicht gefunden: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="141" />
+            <location filename="../processing/algorithms/mesh.py" line="158" />
             <source>{} points in {} reference systems</source>
             <translation>{} Punkte in {} Referenzsystemen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="159" />
+            <location filename="../processing/algorithms/mesh.py" line="176" />
             <source>{} cells -&gt; {} vertices ({:.1%} of the cells), {} faces of which {} wall faces; step threshold {:.2f} m, vertical error &lt;= {:.3f} m</source>
             <translation>{} Zellen -&gt; {} Eckpunkte ({:.1%} der Zellen), {} Dreiecke, davon {} Wanddreiecke; Sprungschwelle {:.2f} m, Höhenfehler &lt;= {:.3f} m</translation>
         </message>
@@ -509,77 +509,77 @@
             <translation>Bilder orientieren (Bündelblockausgleichung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="81" />
+            <location filename="../processing/algorithms/orientimages.py" line="87" />
             <source>Image files (instead of a folder)</source>
             <translation>Bilddateien (statt eines Ordners)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="87" />
+            <location filename="../processing/algorithms/orientimages.py" line="93" />
             <source>Interior orientation file (optional)</source>
             <translation>Datei der inneren Orientierung (optional)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="90" />
+            <location filename="../processing/algorithms/orientimages.py" line="96" />
             <source>Output CRS</source>
             <translation>Ausgabe-KBS</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="94" />
+            <location filename="../processing/algorithms/orientimages.py" line="100" />
             <source>Working resolution (max image side, px)</source>
             <translation>Arbeitsauflösung (größte Bildseite, px)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="104" />
+            <location filename="../processing/algorithms/orientimages.py" line="110" />
             <source>Features per image</source>
             <translation>Merkmale pro Bild</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="112" />
+            <location filename="../processing/algorithms/orientimages.py" line="119" />
             <source>Self-calibration</source>
             <translation>Selbstkalibrierung</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="120" />
+            <location filename="../processing/algorithms/orientimages.py" line="129" />
             <source>Report (HTML)</source>
             <translation>Bericht (HTML)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="120" />
+            <location filename="../processing/algorithms/orientimages.py" line="129" />
             <source>HTML files (*.html)</source>
             <translation>HTML-Dateien (*.html)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="127" />
+            <location filename="../processing/algorithms/orientimages.py" line="136" />
             <source>Tie points</source>
             <translation>Verknüpfungspunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="133" />
+            <location filename="../processing/algorithms/orientimages.py" line="142" />
             <source>GCP and check point residuals</source>
             <translation>Residuen der Pass- und Kontrollpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="146" />
+            <location filename="../processing/algorithms/orientimages.py" line="155" />
             <source>Give either IMAGES (a folder) or IMAGE_FILES, not both</source>
             <translation>Geben Sie entweder IMAGES (einen Ordner) oder IMAGE_FILES an, nicht beides</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="156" />
+            <location filename="../processing/algorithms/orientimages.py" line="165" />
             <source>IMAGES: give an image folder or a list of image files</source>
             <translation>IMAGES: geben Sie einen Bildordner oder eine Liste von Bilddateien an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="197" />
+            <location filename="../processing/algorithms/orientimages.py" line="206" />
             <source>Registered {} of {} images; sigma0 {:.3f} px</source>
             <translation>{} von {} Bildern orientiert; Sigma0 {:.3f} px</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="170" />
+            <location filename="../processing/algorithms/orientimages.py" line="179" />
             <source>{} control and {} check points</source>
             <translation>{} Pass- und {} Kontrollpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="149" />
+            <location filename="../processing/algorithms/orientimages.py" line="158" />
             <source>IMAGES: {} is not a folder</source>
             <translation>IMAGES: {} ist kein Ordner</translation>
         </message>
@@ -589,132 +589,132 @@
             <translation>Dichte Bildzuordnung (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="280" />
+            <location filename="../processing/algorithms/osgm.py" line="307" />
             <source>DSM (OSGM)</source>
             <translation>DOM (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="72" />
+            <location filename="../processing/algorithms/osgm.py" line="86" />
             <source>Extent (default: the area seen by the images)</source>
             <translation>Ausdehnung (Standard: der von den Bildern gesehene Bereich)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="78" />
+            <location filename="../processing/algorithms/osgm.py" line="92" />
             <source>Resolution (m; empty or 0 = median ground sample distance)</source>
             <translation>Auflösung (m; leer oder 0 = mittlere Bodenpixelgröße)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="88" />
+            <location filename="../processing/algorithms/osgm.py" line="102" />
             <source>Height step of the search (m; empty or 0 = the resolution)</source>
             <translation>Höhenschritt der Suche (m; leer oder 0 = die Auflösung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="98" />
+            <location filename="../processing/algorithms/osgm.py" line="112" />
             <source>Lowest height searched (m; empty = automatic)</source>
             <translation>Niedrigste gesuchte Höhe (m; leer = automatisch)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="107" />
+            <location filename="../processing/algorithms/osgm.py" line="121" />
             <source>Highest height searched (m; empty = automatic)</source>
             <translation>Höchste gesuchte Höhe (m; leer = automatisch)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="115" />
+            <location filename="../processing/algorithms/osgm.py" line="129" />
             <source>Coarse surface bounding the search per cell (DSM/DTM)</source>
             <translation>Grobe Oberfläche, die die Suche je Zelle begrenzt (DOM/DGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="121" />
+            <location filename="../processing/algorithms/osgm.py" line="135" />
             <source>Aggregation paths</source>
             <translation>Aggregationspfade</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="129" />
+            <location filename="../processing/algorithms/osgm.py" line="143" />
             <source>Oblique images</source>
             <translation>Schrägbilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="137" />
+            <location filename="../processing/algorithms/osgm.py" line="151" />
             <source>Penalty P1, one height step (cost units; empty = default)</source>
             <translation>Strafterm P1, ein Höhenschritt (Kosteneinheiten; leer = Standard)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="148" />
+            <location filename="../processing/algorithms/osgm.py" line="162" />
             <source>Penalty P2, larger height jumps (cost units; empty = default)</source>
             <translation>Strafterm P2, größere Höhensprünge (Kosteneinheiten; leer = Standard)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="157" />
+            <location filename="../processing/algorithms/osgm.py" line="173" />
             <source>Images per tile (at most)</source>
             <translation>Bilder pro Kachel (höchstens)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="161" />
+            <location filename="../processing/algorithms/osgm.py" line="183" />
             <source>Tile size (cells)</source>
             <translation>Kachelgröße (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="168" />
+            <location filename="../processing/algorithms/osgm.py" line="195" />
             <source>Confidence [0, 1]</source>
             <translation>Konfidenz [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="173" />
+            <location filename="../processing/algorithms/osgm.py" line="200" />
             <source>Orthoimage (matching colours)</source>
             <translation>Orthobild (Farben der Zuordnung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="179" />
+            <location filename="../processing/algorithms/osgm.py" line="206" />
             <source>Point cloud</source>
             <translation>Punktwolke</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="204" />
+            <location filename="../processing/algorithms/osgm.py" line="231" />
             <source>EXTENT: the extent is empty</source>
             <translation>EXTENT: die Ausdehnung ist leer</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="283" />
+            <location filename="../processing/algorithms/osgm.py" line="310" />
             <source>Confidence (OSGM)</source>
             <translation>Konfidenz (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="286" />
+            <location filename="../processing/algorithms/osgm.py" line="313" />
             <source>Orthoimage (OSGM)</source>
             <translation>Orthobild (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="130" />
+            <location filename="../processing/algorithms/osgm.py" line="144" />
             <source>none: one nadir reference system</source>
             <translation>none: ein Nadir-Referenzsystem</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="130" />
+            <location filename="../processing/algorithms/osgm.py" line="144" />
             <source>auto: extra systems for obliques</source>
             <translation>auto: zusätzliche Systeme für Schrägbilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="217" />
+            <location filename="../processing/algorithms/osgm.py" line="244" />
             <source>ORIENTATION: the file {!r} does not exist</source>
             <translation>ORIENTATION: die Datei {!r} existiert nicht</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="229" />
+            <location filename="../processing/algorithms/osgm.py" line="256" />
             <source>Z_MIN ({}) must be below Z_MAX ({})</source>
             <translation>Z_MIN ({}) muss unter Z_MAX ({}) liegen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="245" />
+            <location filename="../processing/algorithms/osgm.py" line="272" />
             <source>POINT_CLOUD: expected a .las or .laz file, got {!r}</source>
             <translation>POINT_CLOUD: .las- oder .laz-Datei erwartet, erhalten: {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="224" />
+            <location filename="../processing/algorithms/osgm.py" line="251" />
             <source>{}: must be positive (or empty), got {}</source>
             <translation>{}: muss positiv (oder leer) sein, erhalten: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="235" />
+            <location filename="../processing/algorithms/osgm.py" line="262" />
             <source>Z_SURFACE: expected a raster file (GeoTIFF), got {!r}</source>
             <translation>Z_SURFACE: Rasterdatei (GeoTIFF) erwartet, erhalten: {!r}</translation>
         </message>
@@ -724,77 +724,77 @@
             <translation>Fotos zum True Orthophoto (gesamte Prozesskette)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="88" />
+            <location filename="../processing/algorithms/pipeline.py" line="94" />
             <source>DSM (filtered)</source>
             <translation>DOM (gefiltert)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="91" />
+            <location filename="../processing/algorithms/pipeline.py" line="97" />
             <source>True orthophoto</source>
             <translation>True Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="92" />
+            <location filename="../processing/algorithms/pipeline.py" line="98" />
             <source>Occlusion mask</source>
             <translation>Verdeckungsmaske</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="93" />
+            <location filename="../processing/algorithms/pipeline.py" line="99" />
             <source>Seamlines</source>
             <translation>Nahtlinien</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="72" />
+            <location filename="../processing/algorithms/pipeline.py" line="76" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Auflösung des DOM und des True Orthophotos (m, 0 = Bodenpixelgröße)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="80" />
+            <location filename="../processing/algorithms/pipeline.py" line="85" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Eine vorhandene orientation.json im Ausgabeordner wiederverwenden</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="108" />
+            <location filename="../processing/algorithms/pipeline.py" line="114" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES: geben Sie den Ordner der Fotos an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="123" />
+            <location filename="../processing/algorithms/pipeline.py" line="129" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER: geben Sie einen Ordner für die Produkte an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="133" />
+            <location filename="../processing/algorithms/pipeline.py" line="139" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION: positive Anzahl Meter oder 0 erwartet</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="167" />
+            <location filename="../processing/algorithms/pipeline.py" line="173" />
             <source>DSM (TruOrtho)</source>
             <translation>DOM (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="168" />
+            <location filename="../processing/algorithms/pipeline.py" line="174" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>True Orthophoto (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="169" />
+            <location filename="../processing/algorithms/pipeline.py" line="175" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Verdeckung (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="170" />
+            <location filename="../processing/algorithms/pipeline.py" line="176" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Nahtlinien (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="153" />
+            <location filename="../processing/algorithms/pipeline.py" line="159" />
             <source>Tiles ran on: {}</source>
             <translation>Kacheln berechnet auf: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="152" />
+            <location filename="../processing/algorithms/pipeline.py" line="158" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{}: {:.1f} s, Spitze {:.0f} MB; {}</translation>
         </message>
@@ -839,17 +839,17 @@
             <translation>Punkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pointcloud.py" line="108" />
+            <location filename="../processing/algorithms/pointcloud.py" line="110" />
             <source>Point clouds (LAS/LAZ)</source>
             <translation>Punktwolken (LAS/LAZ)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pointcloud.py" line="114" />
+            <location filename="../processing/algorithms/pointcloud.py" line="116" />
             <source>Thin duplicates on a voxel grid (m; empty = keep all)</source>
             <translation>Duplikate auf einem Voxelgitter ausdünnen (m; leer = alle behalten)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pointcloud.py" line="121" />
+            <location filename="../processing/algorithms/pointcloud.py" line="123" />
             <source>Merged point cloud</source>
             <translation>Zusammengeführte Punktwolke</translation>
         </message>
@@ -859,7 +859,7 @@
             <translation>{} Punkte nach {} geschrieben</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pointcloud.py" line="148" />
+            <location filename="../processing/algorithms/pointcloud.py" line="150" />
             <source>{} points from {} files ({} after thinning)</source>
             <translation>{} Punkte aus {} Dateien ({} nach dem Ausdünnen)</translation>
         </message>
@@ -869,97 +869,97 @@
             <translation>EPT-Datensatz: {} (als Punktwolken-Layer hinzufügen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="72" />
+            <location filename="../processing/algorithms/trueortho.py" line="84" />
             <source>Surface: DSM raster or mesh</source>
             <translation>Oberfläche: DOM-Raster oder Dreiecksnetz</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="77" />
+            <location filename="../processing/algorithms/trueortho.py" line="89" />
             <source>Extent (default: the surface's)</source>
             <translation>Ausdehnung (Standard: die der Oberfläche)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="82" />
+            <location filename="../processing/algorithms/trueortho.py" line="94" />
             <source>Resolution (CRS units; 0 = the surface's cell size)</source>
             <translation>Auflösung (KBS-Einheiten; 0 = Zellgröße der Oberfläche)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="89" />
+            <location filename="../processing/algorithms/trueortho.py" line="101" />
             <source>Output CRS (default: the orientation's)</source>
             <translation>Ausgabe-KBS (Standard: das der Orientierung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="91" />
+            <location filename="../processing/algorithms/trueortho.py" line="105" />
             <source>Colour correction</source>
             <translation>Farbausgleich</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="95" />
+            <location filename="../processing/algorithms/trueortho.py" line="111" />
             <source>Maximum off-nadir viewing angle (degrees)</source>
             <translation>Größter Blickwinkel zum Nadir (Grad)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="105" />
+            <location filename="../processing/algorithms/trueortho.py" line="121" />
             <source>Blend width across seamlines (cells)</source>
             <translation>Überblendungsbreite an den Nahtlinien (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="126" />
+            <location filename="../processing/algorithms/trueortho.py" line="142" />
             <source>Compression of the orthophoto</source>
             <translation>Kompression des Orthophotos</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="139" />
+            <location filename="../processing/algorithms/trueortho.py" line="155" />
             <source>JPEG quality</source>
             <translation>JPEG-Qualität</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="151" />
+            <location filename="../processing/algorithms/trueortho.py" line="167" />
             <source>Source image index</source>
             <translation>Index des Quellbilds</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="162" />
+            <location filename="../processing/algorithms/trueortho.py" line="178" />
             <source>Seamlines (source image regions)</source>
             <translation>Nahtlinien (Bereiche der Quellbilder)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="177" />
+            <location filename="../processing/algorithms/trueortho.py" line="193" />
             <source>SURFACE: give a DSM raster or a mesh file</source>
             <translation>SURFACE: geben Sie ein DOM-Raster oder eine Netzdatei an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="73" />
+            <location filename="../processing/algorithms/trueortho.py" line="85" />
             <source>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;All files (*.*)</source>
             <translation>Oberflächen (*.tif *.tiff *.vrt *.ply *.obj);;Alle Dateien (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="209" />
+            <location filename="../processing/algorithms/trueortho.py" line="226" />
             <source>{} x {} cells, {} images used, coverage {:.2%}, {} cells seen by no image</source>
             <translation>{} x {} Zellen, {} Bilder verwendet, Abdeckung {:.2%}, {} Zellen von keinem Bild gesehen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="128" />
+            <location filename="../processing/algorithms/trueortho.py" line="144" />
             <source>DEFLATE (lossless, read by every GIS)</source>
             <translation>DEFLATE (verlustfrei, von jedem GIS gelesen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="129" />
+            <location filename="../processing/algorithms/trueortho.py" line="145" />
             <source>ZSTD (lossless, fastest to write, larger)</source>
             <translation>ZSTD (verlustfrei, am schnellsten geschrieben, größer)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="130" />
+            <location filename="../processing/algorithms/trueortho.py" line="146" />
             <source>LZW (lossless)</source>
             <translation>LZW (verlustfrei)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="131" />
+            <location filename="../processing/algorithms/trueortho.py" line="147" />
             <source>JPEG (lossy, 8-bit RGB images only; alpha becomes a mask)</source>
             <translation>JPEG (verlustbehaftet, nur 8-Bit-RGB-Bilder; Alpha wird zur Maske)</translation>
         </message>
         <message>
-            <location filename="../processing/feedback.py" line="59" />
+            <location filename="../processing/feedback.py" line="65" />
             <source>Cancelled by the user</source>
             <translation>Vom Benutzer abgebrochen</translation>
         </message>
@@ -1799,6 +1799,266 @@
             <translation>von keinem Bild gesehen</translation>
         </message>
         <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="202" />
+            <source>Load measurements from a CSV table or gcp_list.txt</source>
+            <translation>Messungen aus einer CSV-Tabelle oder gcp_list.txt laden</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="106" />
+            <source>GCP measurements</source>
+            <translation>GCP-Messungen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="136" />
+            <source>Folder of the photos</source>
+            <translation>Ordner der Fotos</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="140" />
+            <source>Images</source>
+            <translation>Bilder</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="144" />
+            <source>GCP layer</source>
+            <translation>GCP-Layer</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="147" />
+            <source>Optional: orientation to predict the GCPs in the images</source>
+            <translation>Optional: Orientierung, um die GCPs in den Bildern vorherzusagen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="157" />
+            <source>Load</source>
+            <translation>Laden</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="157" />
+            <source>Read the images, the GCPs and the orientation</source>
+            <translation>Bilder, GCPs und Orientierung einlesen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
+            <source>Undo</source>
+            <translation>Rückgängig</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
+            <source>Undo (Ctrl+Z)</source>
+            <translation>Rückgängig (Strg+Z)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="162" />
+            <source>Redo</source>
+            <translation>Wiederholen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="162" />
+            <source>Redo (Ctrl+Shift+Z)</source>
+            <translation>Wiederholen (Strg+Umschalt+Z)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="164" />
+            <source>Delete</source>
+            <translation>Löschen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="165" />
+            <source>Delete the measurement of the current GCP in this image (Del)</source>
+            <translation>Messung des aktuellen GCP in diesem Bild löschen (Entf)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="193" />
+            <source>Click: place the current GCP; drag: pan; wheel: zoom</source>
+            <translation>Klick: aktuellen GCP setzen; Ziehen: verschieben; Mausrad: zoomen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="245" />
+            <source>Orientations (*.json *.txt);;All files (*)</source>
+            <translation>Orientierungen (*.json *.txt);;Alle Dateien (*)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="348" />
+            <source>predicted</source>
+            <translation>vorhergesagt</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="348" />
+            <source>not measured</source>
+            <translation>nicht gemessen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="516" />
+            <source>Save the observation table</source>
+            <translation>Beobachtungstabelle speichern</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="516" />
+            <source>CSV (*.csv)</source>
+            <translation>CSV (*.csv)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
+            <source>Save gcp_list.txt</source>
+            <translation>gcp_list.txt speichern</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="523" />
+            <source>gcp_list (*.txt)</source>
+            <translation>gcp_list (*.txt)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="528" />
+            <source>Open measurements</source>
+            <translation>Messungen öffnen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="529" />
+            <source>Observation tables (*.csv *.txt)</source>
+            <translation>Beobachtungstabellen (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="588" />
+            <source>GCP observations</source>
+            <translation>GCP-Beobachtungen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="139" />
+            <source>Choose the image folder</source>
+            <translation>Bildordner wählen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="151" />
+            <source>Choose an orientation file</source>
+            <translation>Orientierungsdatei wählen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="184" />
+            <source>Previous image (Page Up)</source>
+            <translation>Vorheriges Bild (Bild auf)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="185" />
+            <source>Next image (Page Down)</source>
+            <translation>Nächstes Bild (Bild ab)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="186" />
+            <source>Previous GCP (Ctrl+Page Up)</source>
+            <translation>Vorheriger GCP (Strg+Bild auf)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="187" />
+            <source>Next GCP (Ctrl+Page Down)</source>
+            <translation>Nächster GCP (Strg+Bild ab)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <source>Fit</source>
+            <translation>Einpassen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <source>Show the whole image (F)</source>
+            <translation>Ganzes Bild zeigen (F)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="203" />
+            <source>Open table…</source>
+            <translation>Tabelle öffnen…</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="205" />
+            <source>Save table…</source>
+            <translation>Tabelle speichern…</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="205" />
+            <source>Save the observation table (CSV)</source>
+            <translation>Beobachtungstabelle speichern (CSV)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="208" />
+            <source>Save gcp_list…</source>
+            <translation>gcp_list speichern…</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="208" />
+            <source>Save as ODM gcp_list.txt</source>
+            <translation>Als ODM-gcp_list.txt speichern</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="211" />
+            <source>Add table layer</source>
+            <translation>Tabellenlayer hinzufügen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="211" />
+            <source>Keep the measurements as a table layer in the project</source>
+            <translation>Messungen als Tabellenlayer im Projekt behalten</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="268" />
+            <source>Choose the folder of the photos first.</source>
+            <translation>Zuerst den Ordner der Fotos wählen.</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="271" />
+            <source>Choose a GCP point layer first (fields: name, optional role and z).</source>
+            <translation>Zuerst einen GCP-Punktlayer wählen (Felder: name, optional role und z).</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="295" />
+            <source>{} GCPs, {} images</source>
+            <translation>{} GCPs, {} Bilder</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="438" />
+            <source>Load the images and the GCPs first.</source>
+            <translation>Zuerst die Bilder und die GCPs laden.</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="297" />
+            <source>; {} predicted positions</source>
+            <translation>; {} vorhergesagte Positionen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="499" />
+            <source>{} on {}: {} — {} measured, {} to do — zoom {:.2f}</source>
+            <translation>{} in {}: {} — {} gemessen, {} offen — Zoom {:.2f}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="318" />
+            <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</source>
+            <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="319" />
+            <source> (check point)</source>
+            <translation> (Kontrollpunkt)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="551" />
+            <source>Saved {} measurements to {}</source>
+            <translation>{} Messungen in {} gespeichert</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="576" />
+            <source>Loaded {} measurements from {}</source>
+            <translation>{} Messungen aus {} geladen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="277" />
+            <source>GCP layer {!r} has no point</source>
+            <translation>GCP-Layer {!r} enthält keinen Punkt</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="380" />
+            <source>Cannot read the image {}</source>
+            <translation>Das Bild {} kann nicht gelesen werden</translation>
+        </message>
+        <message>
             <location filename="../truortho_plugin/plugin.py" line="15" />
             <source>&amp;TruOrtho</source>
             <translation>&amp;TruOrtho</translation>
@@ -1834,7 +2094,12 @@
             <translation>True Orthophoto…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/plugin.py" line="111" />
+            <location filename="../truortho_plugin/plugin.py" line="105" />
+            <source>GCP measurements in photos…</source>
+            <translation>GCP-Messungen in Fotos…</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>Der Algorithmus {} ist in dieser Version nicht verfügbar.</translation>
         </message>

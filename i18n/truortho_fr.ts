@@ -4,57 +4,57 @@
     <context>
         <name>TruOrtho</name>
         <message>
-            <location filename="../processing/algorithms/base.py" line="16" />
+            <location filename="../processing/algorithms/base.py" line="20" />
             <source>Orientation</source>
             <translation>Orientation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="16" />
+            <location filename="../processing/algorithms/base.py" line="20" />
             <source>Orthophoto</source>
             <translation>Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="16" />
+            <location filename="../processing/algorithms/base.py" line="20" />
             <source>Surface</source>
             <translation>Surface</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="16" />
+            <location filename="../processing/algorithms/base.py" line="20" />
             <source>Tools</source>
             <translation>Outils</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="71" />
+            <location filename="../processing/algorithms/base.py" line="145" />
             <source>Run tiles on</source>
             <translation>Exécuter les tuiles sur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="84" />
+            <location filename="../processing/algorithms/base.py" line="158" />
             <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
             <translation>Adresse du planificateur Dask (tls://hôte:port ou fichier de planificateur ; vide = TRUORTHO_DASK_SCHEDULER)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="104" />
+            <location filename="../processing/algorithms/base.py" line="178" />
             <source>Ground control points</source>
             <translation>Points d'appui</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="110" />
+            <location filename="../processing/algorithms/base.py" line="184" />
             <source>GCP image measurements (table)</source>
             <translation>Mesures image des points d'appui (table)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="73" />
+            <location filename="../processing/algorithms/base.py" line="147" />
             <source>inprocess: this process (all cores)</source>
             <translation>inprocess : ce processus (tous les cœurs)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="74" />
+            <location filename="../processing/algorithms/base.py" line="148" />
             <source>local: a Dask cluster of worker processes on this computer</source>
             <translation>local : une grappe Dask de processus de travail sur cet ordinateur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="75" />
+            <location filename="../processing/algorithms/base.py" line="149" />
             <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
             <translation>scheduler : un planificateur Dask (SCHEDULER_ADDRESS)</translation>
         </message>
@@ -64,132 +64,132 @@
             <translation>Filtrer le MNS (valeurs aberrantes, trous, lissage, MNT)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="255" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="320" />
             <source>Filtered DSM</source>
             <translation>MNS filtré</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="64" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="81" />
             <source>Raw DSM</source>
             <translation>MNS brut</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="66" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="83" />
             <source>Confidence raster [0, 1]</source>
             <translation>Raster de confiance [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="71" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="88" />
             <source>Outlier threshold (m; empty = 4 x resolution)</source>
             <translation>Seuil des valeurs aberrantes (m ; vide = 4 x la résolution)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="78" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="98" />
             <source>Largest hole width filled (m)</source>
             <translation>Largeur maximale des trous comblés (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="79" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="106" />
             <source>Sharpen blurred height steps</source>
             <translation>Rendre nets les sauts de hauteur flous</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="82" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="111" />
             <source>Edge-preserving smoothing of planar surfaces</source>
             <translation>Lissage des surfaces planes préservant les arêtes</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="88" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="117" />
             <source>Outlier window (cells, odd)</source>
             <translation>Fenêtre des valeurs aberrantes (cellules, impair)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="97" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="128" />
             <source>Supporting neighbours that keep a cell</source>
             <translation>Voisins d'appui qui conservent une cellule</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="101" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="138" />
             <source>Minimum confidence</source>
             <translation>Confiance minimale</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="107" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="149" />
             <source>Confident cells (confidence at least)</source>
             <translation>Cellules fiables (confiance au moins)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="116" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="160" />
             <source>Height step between surfaces (m)</source>
             <translation>Saut de hauteur entre surfaces (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="120" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="170" />
             <source>Smoothing radius (cells)</source>
             <translation>Rayon de lissage (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="126" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="181" />
             <source>Smoothing height tolerance (m; empty = 2.5 x resolution)</source>
             <translation>Tolérance en hauteur du lissage (m ; vide = 2,5 x la résolution)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="137" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="192" />
             <source>Ground filter cell size (m; empty = max(1 m, resolution))</source>
             <translation>Taille de cellule du filtre de sol (m ; vide = max(1 m, résolution))</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="146" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="203" />
             <source>Ground filter window radius (m)</source>
             <translation>Rayon de fenêtre du filtre de sol (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="150" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="213" />
             <source>Ground filter slope (rise/run)</source>
             <translation>Pente du filtre de sol (dénivelé/distance)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="157" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="224" />
             <source>Terrain model (DTM)</source>
             <translation>Modèle numérique de terrain (MNT)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="162" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="229" />
             <source>Normalised DSM (height above terrain)</source>
             <translation>MNS normalisé (hauteur au-dessus du terrain)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="165" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="232" />
             <source>Statistics (JSON)</source>
             <translation>Statistiques (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="166" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="233" />
             <source>Outliers removed (cells)</source>
             <translation>Valeurs aberrantes supprimées (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="167" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="234" />
             <source>Hole cells filled</source>
             <translation>Cellules de trous comblées</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="168" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="235" />
             <source>Holes left as nodata</source>
             <translation>Trous laissés en NoData</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="257" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="322" />
             <source>DTM</source>
             <translation>MNT</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="217" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="282" />
             <source>{} holes ({} cells, widest {:.1f} m) are wider than {} m and stay nodata</source>
             <translation>{} trous ({} cellules, le plus large {:.1f} m) dépassent {} m et restent en NoData</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/dsmfilter.py" line="245" />
+            <location filename="../processing/algorithms/dsmfilter.py" line="310" />
             <source>Ground filter at {:.2f} m: {:.1f} % of the cells are ground</source>
             <translation>Filtre de sol à {:.2f} m : {:.1f} % des cellules sont du sol</translation>
         </message>
@@ -239,37 +239,37 @@
             <translation>Exporter l'orientation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="30" />
+            <location filename="../processing/algorithms/exportorientation.py" line="32" />
             <source>Orientation (TruOrtho JSON)</source>
             <translation>Orientation (JSON TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="34" />
+            <location filename="../processing/algorithms/exportorientation.py" line="36" />
             <source>Format</source>
             <translation>Format</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="39" />
+            <location filename="../processing/algorithms/exportorientation.py" line="41" />
             <source>Output folder</source>
             <translation>Dossier de sortie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="40" />
+            <location filename="../processing/algorithms/exportorientation.py" line="42" />
             <source>Files written</source>
             <translation>Fichiers écrits</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="35" />
+            <location filename="../processing/algorithms/exportorientation.py" line="37" />
             <source>COLMAP text model</source>
             <translation>Modèle texte COLMAP</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="35" />
+            <location filename="../processing/algorithms/exportorientation.py" line="37" />
             <source>Orthority OPK CSV + interior file</source>
             <translation>CSV OPK Orthority + fichier d'orientation interne</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/exportorientation.py" line="52" />
+            <location filename="../processing/algorithms/exportorientation.py" line="54" />
             <source>Wrote {}</source>
             <translation>{} écrit</translation>
         </message>
@@ -279,42 +279,42 @@
             <translation>Importer une liste de points d'appui</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="38" />
+            <location filename="../processing/algorithms/importgcps.py" line="44" />
             <source>GCP list (ODM gcp_list.txt)</source>
             <translation>Liste de points d'appui (gcp_list.txt d'ODM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="41" />
+            <location filename="../processing/algorithms/importgcps.py" line="47" />
             <source>Check point names (comma-separated)</source>
             <translation>Noms des points de contrôle (séparés par des virgules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="47" />
+            <location filename="../processing/algorithms/importgcps.py" line="53" />
             <source>Default sigma XY [m]</source>
             <translation>Sigma XY par défaut [m]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="56" />
+            <location filename="../processing/algorithms/importgcps.py" line="62" />
             <source>Default sigma Z [m]</source>
             <translation>Sigma Z par défaut [m]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="62" />
+            <location filename="../processing/algorithms/importgcps.py" line="68" />
             <source>Reproject to CRS</source>
             <translation>Reprojeter dans le SCR</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="70" />
+            <location filename="../processing/algorithms/importgcps.py" line="76" />
             <source>GCP image measurements</source>
             <translation>Mesures image des points d'appui</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="123" />
+            <location filename="../processing/algorithms/importgcps.py" line="129" />
             <source>{} GCPs ({} check points), {} image measurements</source>
             <translation>{} points d'appui ({} points de contrôle), {} mesures image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importgcps.py" line="97" />
+            <location filename="../processing/algorithms/importgcps.py" line="103" />
             <source>CHECK_POINTS: unknown GCP name(s) {}; the file has {}</source>
             <translation>CHECK_POINTS : nom(s) de point d'appui inconnu(s) {} ; le fichier contient {}</translation>
         </message>
@@ -324,77 +324,77 @@
             <translation>Importer une orientation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="60" />
+            <location filename="../processing/algorithms/importorientation.py" line="62" />
             <source>Orientation file (COLMAP, Orthority CSV, OpenSfM)</source>
             <translation>Fichier d'orientation (COLMAP, CSV Orthority, OpenSfM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="64" />
+            <location filename="../processing/algorithms/importorientation.py" line="66" />
             <source>Interior parameter file (Orthority)</source>
             <translation>Fichier des paramètres internes (Orthority)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="69" />
+            <location filename="../processing/algorithms/importorientation.py" line="71" />
             <source>CRS of the input (when the file has none)</source>
             <translation>SCR de l'entrée (si le fichier n'en indique pas)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="75" />
+            <location filename="../processing/algorithms/importorientation.py" line="77" />
             <source>Image folder</source>
             <translation>Dossier des images</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="84" />
+            <location filename="../processing/algorithms/importorientation.py" line="86" />
             <source>Footprint height</source>
             <translation>Hauteur des emprises</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="91" />
+            <location filename="../processing/algorithms/importorientation.py" line="93" />
             <source>Orientation (JSON)</source>
             <translation>Orientation (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="95" />
+            <location filename="../processing/algorithms/importorientation.py" line="97" />
             <source>Cameras</source>
             <translation>Caméras</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="99" />
+            <location filename="../processing/algorithms/importorientation.py" line="101" />
             <source>Footprints</source>
             <translation>Emprises des images</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="125" />
+            <location filename="../processing/algorithms/importorientation.py" line="127" />
             <source>The orientation has no CRS: it stays in its arbitrary (local) frame. Give CRS (or a georef.json) to georeference it.</source>
             <translation>L'orientation n'a pas de SCR : elle reste dans son repère arbitraire (local). Indiquez CRS (ou un georef.json) pour la géoréférencer.</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="141" />
+            <location filename="../processing/algorithms/importorientation.py" line="143" />
             <source>OBSERVATIONS given without a GCPS layer</source>
             <translation>OBSERVATIONS fourni sans couche GCPS</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="115" />
+            <location filename="../processing/algorithms/importorientation.py" line="117" />
             <source>Read {} images, {} cameras, {} sparse points</source>
             <translation>{} images, {} caméras, {} points épars lus</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="145" />
+            <location filename="../processing/algorithms/importorientation.py" line="147" />
             <source>GCPs need a georeferenced orientation: give CRS for the input</source>
             <translation>Les points d'appui exigent une orientation géoréférencée : indiquez CRS pour l'entrée</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="122" />
+            <location filename="../processing/algorithms/importorientation.py" line="124" />
             <source>{}: the orientation contains no images</source>
             <translation>{} : l'orientation ne contient aucune image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="151" />
+            <location filename="../processing/algorithms/importorientation.py" line="153" />
             <source>{} GCPs with {} image measurements</source>
             <translation>{} points d'appui avec {} mesures image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="187" />
+            <location filename="../processing/algorithms/importorientation.py" line="189" />
             <source>Image {} does not see the plane at height {}</source>
             <translation>L'image {} ne voit pas le plan à la hauteur {}</translation>
         </message>
@@ -404,102 +404,102 @@
             <translation>Maillage à partir d'un MNS ou d'un nuage de points</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="50" />
+            <location filename="../processing/algorithms/mesh.py" line="61" />
             <source>DSM raster or point cloud (LAS/LAZ, EPT ept.json)</source>
             <translation>Raster MNS ou nuage de points (LAS/LAZ, EPT ept.json)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="55" />
+            <location filename="../processing/algorithms/mesh.py" line="66" />
             <source>Orthoimage for vertex colours</source>
             <translation>Orthoimage pour les couleurs des sommets</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="60" />
+            <location filename="../processing/algorithms/mesh.py" line="71" />
             <source>Largest vertical error (m; empty = half the DSM resolution)</source>
             <translation>Erreur verticale maximale (m ; vide = la moitié de la résolution du MNS)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="68" />
+            <location filename="../processing/algorithms/mesh.py" line="81" />
             <source>Smallest height step made a wall (m)</source>
             <translation>Plus petit saut de hauteur transformé en mur (m)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="73" />
+            <location filename="../processing/algorithms/mesh.py" line="90" />
             <source>Steepest slope kept as a surface (degrees)</source>
             <translation>Pente la plus forte conservée comme surface (degrés)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="84" />
+            <location filename="../processing/algorithms/mesh.py" line="101" />
             <source>Largest flat block (cells, power of two)</source>
             <translation>Plus grand bloc plat (cellules, puissance de deux)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="95" />
+            <location filename="../processing/algorithms/mesh.py" line="112" />
             <source>Point clouds: longest triangle edge (m; empty = automatic)</source>
             <translation>Nuages de points : arête de triangle la plus longue (m ; vide = automatique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="106" />
+            <location filename="../processing/algorithms/mesh.py" line="123" />
             <source>Coordinates</source>
             <translation>Coordonnées</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="113" />
+            <location filename="../processing/algorithms/mesh.py" line="130" />
             <source>Mesh</source>
             <translation>Maillage</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="113" />
+            <location filename="../processing/algorithms/mesh.py" line="130" />
             <source>PLY mesh (*.ply);;Wavefront OBJ (*.obj)</source>
             <translation>Maillage PLY (*.ply);;Wavefront OBJ (*.obj)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="116" />
+            <location filename="../processing/algorithms/mesh.py" line="133" />
             <source>Vertices</source>
             <translation>Sommets</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="117" />
+            <location filename="../processing/algorithms/mesh.py" line="134" />
             <source>Faces</source>
             <translation>Faces</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="118" />
+            <location filename="../processing/algorithms/mesh.py" line="135" />
             <source>Wall faces</source>
             <translation>Faces de mur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="51" />
+            <location filename="../processing/algorithms/mesh.py" line="62" />
             <source>DSM or point cloud (*.tif *.tiff *.las *.laz *.json);;All files (*.*)</source>
             <translation>MNS ou nuage de points (*.tif *.tiff *.las *.laz *.json);;Tous les fichiers (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="107" />
+            <location filename="../processing/algorithms/mesh.py" line="124" />
             <source>CRS (world coordinates)</source>
             <translation>SCR (coordonnées terrain)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="107" />
+            <location filename="../processing/algorithms/mesh.py" line="124" />
             <source>Local frame (world - offset, offset in the header)</source>
             <translation>Repère local (terrain - décalage, décalage dans l'en-tête)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="138" />
+            <location filename="../processing/algorithms/mesh.py" line="155" />
             <source>ORTHO is ignored for point clouds (their own colours are used)</source>
             <translation>ORTHO est ignoré pour les nuages de points (leurs propres couleurs sont utilisées)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="128" />
+            <location filename="../processing/algorithms/mesh.py" line="145" />
             <source>INPUT: file not found: {}</source>
             <translation>INPUT : fichier introuvable : {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="141" />
+            <location filename="../processing/algorithms/mesh.py" line="158" />
             <source>{} points in {} reference systems</source>
             <translation>{} points dans {} systèmes de référence</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/mesh.py" line="159" />
+            <location filename="../processing/algorithms/mesh.py" line="176" />
             <source>{} cells -&gt; {} vertices ({:.1%} of the cells), {} faces of which {} wall faces; step threshold {:.2f} m, vertical error &lt;= {:.3f} m</source>
             <translation>{} cellules -&gt; {} sommets ({:.1%} des cellules), {} faces dont {} faces de mur ; seuil de saut {:.2f} m, erreur verticale &lt;= {:.3f} m</translation>
         </message>
@@ -509,77 +509,77 @@
             <translation>Orienter les images (compensation par faisceaux)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="81" />
+            <location filename="../processing/algorithms/orientimages.py" line="87" />
             <source>Image files (instead of a folder)</source>
             <translation>Fichiers image (au lieu d'un dossier)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="87" />
+            <location filename="../processing/algorithms/orientimages.py" line="93" />
             <source>Interior orientation file (optional)</source>
             <translation>Fichier d'orientation interne (facultatif)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="90" />
+            <location filename="../processing/algorithms/orientimages.py" line="96" />
             <source>Output CRS</source>
             <translation>SCR de sortie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="94" />
+            <location filename="../processing/algorithms/orientimages.py" line="100" />
             <source>Working resolution (max image side, px)</source>
             <translation>Résolution de travail (plus grand côté de l'image, px)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="104" />
+            <location filename="../processing/algorithms/orientimages.py" line="110" />
             <source>Features per image</source>
             <translation>Points caractéristiques par image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="112" />
+            <location filename="../processing/algorithms/orientimages.py" line="119" />
             <source>Self-calibration</source>
             <translation>Autocalibration</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="120" />
+            <location filename="../processing/algorithms/orientimages.py" line="129" />
             <source>Report (HTML)</source>
             <translation>Rapport (HTML)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="120" />
+            <location filename="../processing/algorithms/orientimages.py" line="129" />
             <source>HTML files (*.html)</source>
             <translation>Fichiers HTML (*.html)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="127" />
+            <location filename="../processing/algorithms/orientimages.py" line="136" />
             <source>Tie points</source>
             <translation>Points de liaison</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="133" />
+            <location filename="../processing/algorithms/orientimages.py" line="142" />
             <source>GCP and check point residuals</source>
             <translation>Résidus des points d'appui et de contrôle</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="146" />
+            <location filename="../processing/algorithms/orientimages.py" line="155" />
             <source>Give either IMAGES (a folder) or IMAGE_FILES, not both</source>
             <translation>Indiquez soit IMAGES (un dossier), soit IMAGE_FILES, pas les deux</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="156" />
+            <location filename="../processing/algorithms/orientimages.py" line="165" />
             <source>IMAGES: give an image folder or a list of image files</source>
             <translation>IMAGES : indiquez un dossier d'images ou une liste de fichiers image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="197" />
+            <location filename="../processing/algorithms/orientimages.py" line="206" />
             <source>Registered {} of {} images; sigma0 {:.3f} px</source>
             <translation>{} images sur {} orientées ; sigma0 {:.3f} px</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="170" />
+            <location filename="../processing/algorithms/orientimages.py" line="179" />
             <source>{} control and {} check points</source>
             <translation>{} points d'appui et {} points de contrôle</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="149" />
+            <location filename="../processing/algorithms/orientimages.py" line="158" />
             <source>IMAGES: {} is not a folder</source>
             <translation>IMAGES : {} n'est pas un dossier</translation>
         </message>
@@ -589,132 +589,132 @@
             <translation>Appariement dense (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="280" />
+            <location filename="../processing/algorithms/osgm.py" line="307" />
             <source>DSM (OSGM)</source>
             <translation>MNS (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="72" />
+            <location filename="../processing/algorithms/osgm.py" line="86" />
             <source>Extent (default: the area seen by the images)</source>
             <translation>Emprise (par défaut : la zone vue par les images)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="78" />
+            <location filename="../processing/algorithms/osgm.py" line="92" />
             <source>Resolution (m; empty or 0 = median ground sample distance)</source>
             <translation>Résolution (m ; vide ou 0 = taille médiane du pixel au sol)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="88" />
+            <location filename="../processing/algorithms/osgm.py" line="102" />
             <source>Height step of the search (m; empty or 0 = the resolution)</source>
             <translation>Pas de hauteur de la recherche (m ; vide ou 0 = la résolution)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="98" />
+            <location filename="../processing/algorithms/osgm.py" line="112" />
             <source>Lowest height searched (m; empty = automatic)</source>
             <translation>Hauteur minimale recherchée (m ; vide = automatique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="107" />
+            <location filename="../processing/algorithms/osgm.py" line="121" />
             <source>Highest height searched (m; empty = automatic)</source>
             <translation>Hauteur maximale recherchée (m ; vide = automatique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="115" />
+            <location filename="../processing/algorithms/osgm.py" line="129" />
             <source>Coarse surface bounding the search per cell (DSM/DTM)</source>
             <translation>Surface grossière bornant la recherche par cellule (MNS/MNT)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="121" />
+            <location filename="../processing/algorithms/osgm.py" line="135" />
             <source>Aggregation paths</source>
             <translation>Chemins d'agrégation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="129" />
+            <location filename="../processing/algorithms/osgm.py" line="143" />
             <source>Oblique images</source>
             <translation>Images obliques</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="137" />
+            <location filename="../processing/algorithms/osgm.py" line="151" />
             <source>Penalty P1, one height step (cost units; empty = default)</source>
             <translation>Pénalité P1, un pas de hauteur (unités de coût ; vide = par défaut)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="148" />
+            <location filename="../processing/algorithms/osgm.py" line="162" />
             <source>Penalty P2, larger height jumps (cost units; empty = default)</source>
             <translation>Pénalité P2, sauts de hauteur plus grands (unités de coût ; vide = par défaut)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="157" />
+            <location filename="../processing/algorithms/osgm.py" line="173" />
             <source>Images per tile (at most)</source>
             <translation>Images par tuile (au plus)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="161" />
+            <location filename="../processing/algorithms/osgm.py" line="183" />
             <source>Tile size (cells)</source>
             <translation>Taille des tuiles (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="168" />
+            <location filename="../processing/algorithms/osgm.py" line="195" />
             <source>Confidence [0, 1]</source>
             <translation>Confiance [0, 1]</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="173" />
+            <location filename="../processing/algorithms/osgm.py" line="200" />
             <source>Orthoimage (matching colours)</source>
             <translation>Orthoimage (couleurs de l'appariement)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="179" />
+            <location filename="../processing/algorithms/osgm.py" line="206" />
             <source>Point cloud</source>
             <translation>Nuage de points</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="204" />
+            <location filename="../processing/algorithms/osgm.py" line="231" />
             <source>EXTENT: the extent is empty</source>
             <translation>EXTENT : l'emprise est vide</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="283" />
+            <location filename="../processing/algorithms/osgm.py" line="310" />
             <source>Confidence (OSGM)</source>
             <translation>Confiance (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="286" />
+            <location filename="../processing/algorithms/osgm.py" line="313" />
             <source>Orthoimage (OSGM)</source>
             <translation>Orthoimage (OSGM)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="130" />
+            <location filename="../processing/algorithms/osgm.py" line="144" />
             <source>none: one nadir reference system</source>
             <translation>none : un seul système de référence au nadir</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="130" />
+            <location filename="../processing/algorithms/osgm.py" line="144" />
             <source>auto: extra systems for obliques</source>
             <translation>auto : systèmes supplémentaires pour les obliques</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="217" />
+            <location filename="../processing/algorithms/osgm.py" line="244" />
             <source>ORIENTATION: the file {!r} does not exist</source>
             <translation>ORIENTATION : le fichier {!r} n'existe pas</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="229" />
+            <location filename="../processing/algorithms/osgm.py" line="256" />
             <source>Z_MIN ({}) must be below Z_MAX ({})</source>
             <translation>Z_MIN ({}) doit être inférieur à Z_MAX ({})</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="245" />
+            <location filename="../processing/algorithms/osgm.py" line="272" />
             <source>POINT_CLOUD: expected a .las or .laz file, got {!r}</source>
             <translation>POINT_CLOUD : fichier .las ou .laz attendu, reçu {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="224" />
+            <location filename="../processing/algorithms/osgm.py" line="251" />
             <source>{}: must be positive (or empty), got {}</source>
             <translation>{} : doit être positif (ou vide), reçu {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/osgm.py" line="235" />
+            <location filename="../processing/algorithms/osgm.py" line="262" />
             <source>Z_SURFACE: expected a raster file (GeoTIFF), got {!r}</source>
             <translation>Z_SURFACE : fichier raster (GeoTIFF) attendu, reçu {!r}</translation>
         </message>
@@ -724,77 +724,77 @@
             <translation>Des photos à l'orthophoto vraie (chaîne complète)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="88" />
+            <location filename="../processing/algorithms/pipeline.py" line="94" />
             <source>DSM (filtered)</source>
             <translation>MNS (filtré)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="91" />
+            <location filename="../processing/algorithms/pipeline.py" line="97" />
             <source>True orthophoto</source>
             <translation>Orthophoto vraie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="92" />
+            <location filename="../processing/algorithms/pipeline.py" line="98" />
             <source>Occlusion mask</source>
             <translation>Masque d'occultation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="93" />
+            <location filename="../processing/algorithms/pipeline.py" line="99" />
             <source>Seamlines</source>
             <translation>Lignes de raccord</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="72" />
+            <location filename="../processing/algorithms/pipeline.py" line="76" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Résolution du MNS et de l'orthophoto vraie (m, 0 = taille du pixel au sol)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="80" />
+            <location filename="../processing/algorithms/pipeline.py" line="85" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Réutiliser un orientation.json existant dans le dossier de sortie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="108" />
+            <location filename="../processing/algorithms/pipeline.py" line="114" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES : indiquez le dossier des photos</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="123" />
+            <location filename="../processing/algorithms/pipeline.py" line="129" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER : indiquez un dossier pour les produits</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="133" />
+            <location filename="../processing/algorithms/pipeline.py" line="139" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION : nombre positif de mètres ou 0 attendu</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="167" />
+            <location filename="../processing/algorithms/pipeline.py" line="173" />
             <source>DSM (TruOrtho)</source>
             <translation>MNS (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="168" />
+            <location filename="../processing/algorithms/pipeline.py" line="174" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>Orthophoto vraie (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="169" />
+            <location filename="../processing/algorithms/pipeline.py" line="175" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Occultation (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="170" />
+            <location filename="../processing/algorithms/pipeline.py" line="176" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Lignes de raccord (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="153" />
+            <location filename="../processing/algorithms/pipeline.py" line="159" />
             <source>Tiles ran on: {}</source>
             <translation>Tuiles calculées sur : {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="152" />
+            <location filename="../processing/algorithms/pipeline.py" line="158" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{} : {:.1f} s, pic {:.0f} Mo ; {}</translation>
         </message>
@@ -839,17 +839,17 @@
             <translation>Points</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pointcloud.py" line="108" />
+            <location filename="../processing/algorithms/pointcloud.py" line="110" />
             <source>Point clouds (LAS/LAZ)</source>
             <translation>Nuages de points (LAS/LAZ)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pointcloud.py" line="114" />
+            <location filename="../processing/algorithms/pointcloud.py" line="116" />
             <source>Thin duplicates on a voxel grid (m; empty = keep all)</source>
             <translation>Éclaircir les doublons sur une grille de voxels (m ; vide = tout conserver)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pointcloud.py" line="121" />
+            <location filename="../processing/algorithms/pointcloud.py" line="123" />
             <source>Merged point cloud</source>
             <translation>Nuage de points fusionné</translation>
         </message>
@@ -859,7 +859,7 @@
             <translation>{} points écrits dans {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pointcloud.py" line="148" />
+            <location filename="../processing/algorithms/pointcloud.py" line="150" />
             <source>{} points from {} files ({} after thinning)</source>
             <translation>{} points issus de {} fichiers ({} après éclaircissement)</translation>
         </message>
@@ -869,97 +869,97 @@
             <translation>Jeu de données EPT : {} (à ajouter comme couche nuage de points)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="72" />
+            <location filename="../processing/algorithms/trueortho.py" line="84" />
             <source>Surface: DSM raster or mesh</source>
             <translation>Surface : raster MNS ou maillage</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="77" />
+            <location filename="../processing/algorithms/trueortho.py" line="89" />
             <source>Extent (default: the surface's)</source>
             <translation>Emprise (par défaut : celle de la surface)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="82" />
+            <location filename="../processing/algorithms/trueortho.py" line="94" />
             <source>Resolution (CRS units; 0 = the surface's cell size)</source>
             <translation>Résolution (unités du SCR ; 0 = taille de cellule de la surface)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="89" />
+            <location filename="../processing/algorithms/trueortho.py" line="101" />
             <source>Output CRS (default: the orientation's)</source>
             <translation>SCR de sortie (par défaut : celui de l'orientation)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="91" />
+            <location filename="../processing/algorithms/trueortho.py" line="105" />
             <source>Colour correction</source>
             <translation>Correction colorimétrique</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="95" />
+            <location filename="../processing/algorithms/trueortho.py" line="111" />
             <source>Maximum off-nadir viewing angle (degrees)</source>
             <translation>Angle de visée maximal par rapport au nadir (degrés)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="105" />
+            <location filename="../processing/algorithms/trueortho.py" line="121" />
             <source>Blend width across seamlines (cells)</source>
             <translation>Largeur du fondu aux lignes de raccord (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="126" />
+            <location filename="../processing/algorithms/trueortho.py" line="142" />
             <source>Compression of the orthophoto</source>
             <translation>Compression de l'orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="139" />
+            <location filename="../processing/algorithms/trueortho.py" line="155" />
             <source>JPEG quality</source>
             <translation>Qualité JPEG</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="151" />
+            <location filename="../processing/algorithms/trueortho.py" line="167" />
             <source>Source image index</source>
             <translation>Index de l'image source</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="162" />
+            <location filename="../processing/algorithms/trueortho.py" line="178" />
             <source>Seamlines (source image regions)</source>
             <translation>Lignes de raccord (zones des images sources)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="177" />
+            <location filename="../processing/algorithms/trueortho.py" line="193" />
             <source>SURFACE: give a DSM raster or a mesh file</source>
             <translation>SURFACE : indiquez un raster MNS ou un fichier de maillage</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="73" />
+            <location filename="../processing/algorithms/trueortho.py" line="85" />
             <source>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;All files (*.*)</source>
             <translation>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;Tous les fichiers (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="209" />
+            <location filename="../processing/algorithms/trueortho.py" line="226" />
             <source>{} x {} cells, {} images used, coverage {:.2%}, {} cells seen by no image</source>
             <translation>{} x {} cellules, {} images utilisées, couverture {:.2%}, {} cellules vues par aucune image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="128" />
+            <location filename="../processing/algorithms/trueortho.py" line="144" />
             <source>DEFLATE (lossless, read by every GIS)</source>
             <translation>DEFLATE (sans perte, lu par tous les SIG)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="129" />
+            <location filename="../processing/algorithms/trueortho.py" line="145" />
             <source>ZSTD (lossless, fastest to write, larger)</source>
             <translation>ZSTD (sans perte, écriture la plus rapide, plus volumineux)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="130" />
+            <location filename="../processing/algorithms/trueortho.py" line="146" />
             <source>LZW (lossless)</source>
             <translation>LZW (sans perte)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="131" />
+            <location filename="../processing/algorithms/trueortho.py" line="147" />
             <source>JPEG (lossy, 8-bit RGB images only; alpha becomes a mask)</source>
             <translation>JPEG (avec perte, images RVB 8 bits seulement ; l'alpha devient un masque)</translation>
         </message>
         <message>
-            <location filename="../processing/feedback.py" line="59" />
+            <location filename="../processing/feedback.py" line="65" />
             <source>Cancelled by the user</source>
             <translation>Annulé par l'utilisateur</translation>
         </message>
@@ -1799,6 +1799,266 @@
             <translation>vu par aucune image</translation>
         </message>
         <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="202" />
+            <source>Load measurements from a CSV table or gcp_list.txt</source>
+            <translation>Charger les mesures depuis une table CSV ou un gcp_list.txt</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="106" />
+            <source>GCP measurements</source>
+            <translation>Mesures des points d'appui</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="136" />
+            <source>Folder of the photos</source>
+            <translation>Dossier des photos</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="140" />
+            <source>Images</source>
+            <translation>Images</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="144" />
+            <source>GCP layer</source>
+            <translation>Couche des points d'appui</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="147" />
+            <source>Optional: orientation to predict the GCPs in the images</source>
+            <translation>Facultatif : orientation pour prédire les points d'appui dans les images</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="157" />
+            <source>Load</source>
+            <translation>Charger</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="157" />
+            <source>Read the images, the GCPs and the orientation</source>
+            <translation>Lire les images, les points d'appui et l'orientation</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
+            <source>Undo</source>
+            <translation>Annuler</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
+            <source>Undo (Ctrl+Z)</source>
+            <translation>Annuler (Ctrl+Z)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="162" />
+            <source>Redo</source>
+            <translation>Rétablir</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="162" />
+            <source>Redo (Ctrl+Shift+Z)</source>
+            <translation>Rétablir (Ctrl+Maj+Z)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="164" />
+            <source>Delete</source>
+            <translation>Supprimer</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="165" />
+            <source>Delete the measurement of the current GCP in this image (Del)</source>
+            <translation>Supprimer la mesure du point d'appui courant dans cette image (Suppr)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="193" />
+            <source>Click: place the current GCP; drag: pan; wheel: zoom</source>
+            <translation>Clic : placer le point d'appui courant ; glisser : déplacer la vue ; molette : zoomer</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="245" />
+            <source>Orientations (*.json *.txt);;All files (*)</source>
+            <translation>Orientations (*.json *.txt);;Tous les fichiers (*)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="348" />
+            <source>predicted</source>
+            <translation>prédit</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="348" />
+            <source>not measured</source>
+            <translation>non mesuré</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="516" />
+            <source>Save the observation table</source>
+            <translation>Enregistrer la table des observations</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="516" />
+            <source>CSV (*.csv)</source>
+            <translation>CSV (*.csv)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
+            <source>Save gcp_list.txt</source>
+            <translation>Enregistrer gcp_list.txt</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="523" />
+            <source>gcp_list (*.txt)</source>
+            <translation>gcp_list (*.txt)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="528" />
+            <source>Open measurements</source>
+            <translation>Ouvrir des mesures</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="529" />
+            <source>Observation tables (*.csv *.txt)</source>
+            <translation>Tables d'observations (*.csv *.txt)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="588" />
+            <source>GCP observations</source>
+            <translation>Observations des points d'appui</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="139" />
+            <source>Choose the image folder</source>
+            <translation>Choisir le dossier des images</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="151" />
+            <source>Choose an orientation file</source>
+            <translation>Choisir un fichier d'orientation</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="184" />
+            <source>Previous image (Page Up)</source>
+            <translation>Image précédente (Page préc.)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="185" />
+            <source>Next image (Page Down)</source>
+            <translation>Image suivante (Page suiv.)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="186" />
+            <source>Previous GCP (Ctrl+Page Up)</source>
+            <translation>Point d'appui précédent (Ctrl+Page préc.)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="187" />
+            <source>Next GCP (Ctrl+Page Down)</source>
+            <translation>Point d'appui suivant (Ctrl+Page suiv.)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <source>Fit</source>
+            <translation>Ajuster</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <source>Show the whole image (F)</source>
+            <translation>Afficher l'image entière (F)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="203" />
+            <source>Open table…</source>
+            <translation>Ouvrir une table…</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="205" />
+            <source>Save table…</source>
+            <translation>Enregistrer la table…</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="205" />
+            <source>Save the observation table (CSV)</source>
+            <translation>Enregistrer la table des observations (CSV)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="208" />
+            <source>Save gcp_list…</source>
+            <translation>Enregistrer gcp_list…</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="208" />
+            <source>Save as ODM gcp_list.txt</source>
+            <translation>Enregistrer au format ODM gcp_list.txt</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="211" />
+            <source>Add table layer</source>
+            <translation>Ajouter une couche table</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="211" />
+            <source>Keep the measurements as a table layer in the project</source>
+            <translation>Conserver les mesures comme couche table dans le projet</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="268" />
+            <source>Choose the folder of the photos first.</source>
+            <translation>Choisissez d'abord le dossier des photos.</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="271" />
+            <source>Choose a GCP point layer first (fields: name, optional role and z).</source>
+            <translation>Choisissez d'abord une couche de points d'appui (champs : name, role et z facultatifs).</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="295" />
+            <source>{} GCPs, {} images</source>
+            <translation>{} points d'appui, {} images</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="438" />
+            <source>Load the images and the GCPs first.</source>
+            <translation>Chargez d'abord les images et les points d'appui.</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="297" />
+            <source>; {} predicted positions</source>
+            <translation> ; {} positions prédites</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="499" />
+            <source>{} on {}: {} — {} measured, {} to do — zoom {:.2f}</source>
+            <translation>{} sur {} : {} — {} mesurées, {} à faire — zoom {:.2f}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="318" />
+            <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</source>
+            <translation>{} : X {:.3f}, Y {:.3f}, Z {:.3f}{}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="319" />
+            <source> (check point)</source>
+            <translation> (point de contrôle)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="551" />
+            <source>Saved {} measurements to {}</source>
+            <translation>{} mesures enregistrées dans {}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="576" />
+            <source>Loaded {} measurements from {}</source>
+            <translation>{} mesures chargées depuis {}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="277" />
+            <source>GCP layer {!r} has no point</source>
+            <translation>La couche de points d'appui {!r} ne contient aucun point</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="380" />
+            <source>Cannot read the image {}</source>
+            <translation>Impossible de lire l'image {}</translation>
+        </message>
+        <message>
             <location filename="../truortho_plugin/plugin.py" line="15" />
             <source>&amp;TruOrtho</source>
             <translation>&amp;TruOrtho</translation>
@@ -1834,7 +2094,12 @@
             <translation>Orthophoto vraie…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/plugin.py" line="111" />
+            <location filename="../truortho_plugin/plugin.py" line="105" />
+            <source>GCP measurements in photos…</source>
+            <translation>Mesures des points d'appui dans les photos…</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>L'algorithme {} n'est pas disponible dans cette version.</translation>
         </message>
