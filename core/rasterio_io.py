@@ -14,6 +14,7 @@ older file of the same name before the new one is ready).
 * :func:`write_point_cloud` and :class:`PointCloudWriter` (in chunks): LAS 1.4 /
   LAZ with RGB, extra dimensions, extra VLRs and the CRS as WKT;
   :func:`read_point_cloud_arrays` reads them back.
+* :func:`write_seamlines`: the true orthophoto's seamline polygons as a GeoPackage.
 
 GDAL-linked packages come from the same distribution as QGIS (README,
 "Dependency policy"); rasterio is imported lazily.
@@ -743,3 +744,41 @@ def read_point_cloud_arrays(path) -> dict[str, Any]:
         if hasattr(v, "record_data") and isinstance(getattr(v, "record_data", None), bytes | bytearray):
             vlrs[(v.user_id, v.record_id)] = bytes(v.record_data)
     return {"xyz": xyz, "rgb": rgb, "extra": extra, "crs": crs, "vlrs": vlrs}
+
+
+def write_seamlines(path, regions, crs) -> None:
+    """Seamline polygons as a GeoPackage layer ``seamlines``, written atomically.
+
+    Parameters
+    ----------
+    path : path
+        Destination ``.gpkg``.
+    regions : sequence of SeamRegion
+        One per source image (:class:`truortho.core.ortho.pipeline.SeamRegion`: ``wkt`` a
+        polygon or multipolygon in ``crs``, ``image_index``, ``image_name``, ``cells``). They
+        become multipolygon features with the fields ``image``, ``name`` and ``cells``.
+    crs : str or None
+        CRS of the polygons (WKT, ``EPSG:n``, ...); None writes a layer without one.
+    """
+    from osgeo import ogr, osr
+
+    with atomic_output(path) as tmp:
+        drv = ogr.GetDriverByName("GPKG")
+        ds = drv.CreateDataSource(str(tmp))
+        srs = osr.SpatialReference()
+        if crs:
+            srs.SetFromUserInput(str(crs))
+            srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
+        layer = ds.CreateLayer("seamlines", srs if crs else None, ogr.wkbMultiPolygon)
+        for name, kind in (("image", ogr.OFTInteger), ("name", ogr.OFTString), ("cells", ogr.OFTInteger)):
+            layer.CreateField(ogr.FieldDefn(name, kind))
+        for r in regions:
+            f = ogr.Feature(layer.GetLayerDefn())
+            geom = ogr.ForceToMultiPolygon(ogr.CreateGeometryFromWkt(r.wkt))
+            f.SetGeometry(geom)
+            f.SetField("image", int(r.image_index))
+            f.SetField("name", str(r.image_name))
+            f.SetField("cells", int(r.cells))
+            layer.CreateFeature(f)
+        ds = None  # close before the rename
+        del ds

@@ -3,6 +3,10 @@
 Every stage returns plain numbers (dicts of floats, lists, tables) that are
 saved as JSON for machines and rendered here for people. Figures are
 matplotlib PNGs embedded as base64, so the HTML opens offline.
+
+:func:`pipeline_report` assembles the whole chain's report (the orientation's part, the DSM
+hillshade, the true-ortho preview); :func:`reused_orientation_report` reads the orientation's
+part back from an earlier ``report.json``.
 """
 
 from __future__ import annotations
@@ -96,6 +100,18 @@ class Report:
         out.append("</body></html>")
         return "\n".join(out)
 
+    @classmethod
+    def from_json(cls, d: dict) -> Report:
+        """A report from its JSON document (:meth:`to_json`; figures are not in the JSON)."""
+        return cls(
+            str(d.get("title", "")),
+            dict(d.get("summary", {})),
+            [Table(t["title"], t["columns"], t["rows"], t.get("note", "")) for t in d.get("tables", [])],
+            [],
+            dict(d.get("data", {})),
+            list(d.get("warnings", [])),
+        )
+
     def save(
         self, html_path: str | os.PathLike, json_path: str | os.PathLike | None = None
     ) -> tuple[str, str]:
@@ -105,6 +121,136 @@ class Report:
         atomic_write_text(jp, json.dumps(self.to_json(), indent=1, allow_nan=False))
         atomic_write_text(hp, self.to_html())
         return str(hp), str(jp)
+
+
+#: Tables :func:`pipeline_report` adds after the orientation's (they belong to one run of the chain).
+_CHAIN_TABLES = ("Dense matching and DSM filter", "Stages")
+
+
+def reused_orientation_report(json_path: str | os.PathLike) -> Report | None:
+    """The orientation's part of an earlier pipeline report (``report.json``), or None.
+
+    Keeps the tables and the summary entries of the orientation; those of the rest of the chain
+    (dense matching and DSM filter, stages, DSM, true orthophoto, totals, executor) belong to the
+    new run.
+    """
+    p = Path(json_path)
+    if not p.exists():
+        return None
+    try:
+        d = json.loads(p.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    old = Report.from_json(d)
+    rep = Report("orientation (reused)")
+    rep.tables = [t for t in old.tables if t.title not in _CHAIN_TABLES]
+    this_run = ("DSM", "true", "total", "tiles")  # the rest of the chain, not the orientation
+    rep.summary = {k: v for k, v in old.summary.items() if not str(k).startswith(this_run)}
+    return rep
+
+
+def pipeline_report(
+    title: str,
+    orient_report: Report | None,
+    orientation,
+    osgm,
+    fstats,
+    dsm_path,
+    ortho_path,
+    tres,
+    reused: bool,
+) -> Report:
+    """The whole chain's report (:func:`truortho.core.workflow.run_workflow`), but its stage table.
+
+    Parameters
+    ----------
+    title : str
+    orient_report : Report or None
+        The orientation's report (tables, figures, warnings are taken over).
+    orientation : Orientation
+    osgm : OsgmResult
+        Dense matching (``stats``, ``summary()``).
+    fstats : DsmFilterStats
+        The DSM filter's statistics.
+    dsm_path, ortho_path : path
+        The filtered DSM and the true orthophoto (read for the hillshade and the preview).
+    tres : TrueOrthoResult
+        The true orthophoto's result (``stats``: coverage, occluded cells, size).
+    reused : bool
+        The orientation was read from an existing file.
+
+    Returns
+    -------
+    Report
+        Ending with an empty "Stages" table (stage, time [s], peak memory [MB], result) for the
+        caller to fill.
+    """
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from .rasterio_io import read_raster
+
+    report = Report(title)
+    if orient_report is not None:
+        report.data["orientation"] = orient_report.data
+        report.summary.update(orient_report.summary)
+        report.tables.extend(orient_report.tables)
+        report.figures.extend(orient_report.figures)
+        report.warnings.extend(orient_report.warnings)
+    if reused:
+        report.warnings.append("The orientation was reused from orientation.json (not recomputed).")
+    report.summary["images oriented"] = len(orientation.images)
+    report.summary["CRS"] = orientation.crs
+    s = osgm.stats
+    report.data["osgm"] = s
+    report.data["filter"] = fstats.as_dict()
+    report.data["trueortho"] = {k: v for k, v in tres.stats.items() if isinstance(v, int | float | str)}
+    report.summary["DSM resolution [m]"] = s["resolution"]
+    report.summary["DSM completeness (raw) [%]"] = round(100 * s["completeness"], 2)
+    dsm, grid, _ = read_raster(dsm_path)
+    report.summary["DSM completeness (filtered) [%]"] = round(100 * float(np.isfinite(dsm).mean()), 2)
+    st = tres.stats
+    occl = float(st.get("cells_occluded", 0)) / max(1, int(st.get("rows", 1)) * int(st.get("cols", 1)))
+    report.summary["true ortho coverage [%]"] = round(100 * float(st["coverage"]), 2)
+    report.summary["true ortho occluded share [%]"] = round(100 * occl, 2)
+    report.tables.append(
+        Table(_CHAIN_TABLES[0], ["what", "value"], [["OSGM", osgm.summary()], ["filter", fstats.summary()]])
+    )
+    # DSM hillshade
+    fig, ax = plt.subplots(figsize=(7, 6))
+    z = np.where(np.isfinite(dsm), dsm, np.nanmedian(dsm) if np.isfinite(dsm).any() else 0)
+    gy, gx = np.gradient(z, grid.res)
+    slope = np.pi / 2 - np.arctan(np.hypot(gx, gy))
+    aspect = np.arctan2(-gx, gy)
+    az, alt = np.radians(315), np.radians(45)
+    shade = np.sin(alt) * np.sin(slope) + np.cos(alt) * np.cos(slope) * np.cos(az - aspect)
+    ext = (grid.extent[0], grid.extent[2], grid.extent[1], grid.extent[3])
+    ax.imshow(np.where(np.isfinite(dsm), shade, np.nan), cmap="gray", extent=ext)
+    im = ax.imshow(np.where(np.isfinite(dsm), dsm, np.nan), cmap="terrain", alpha=0.45, extent=ext)
+    fig.colorbar(im, ax=ax, label="height [m]")
+    ax.set_title(f"Filtered DSM ({100 * float(np.isfinite(dsm).mean()):.1f} % of the cells)")
+    report.add_figure("DSM hillshade (filtered DSM)", fig)
+    # true ortho preview
+    ortho, og, _ = read_raster(ortho_path, band=None)
+    step = max(1, int(np.ceil(max(ortho.shape[1:]) / 1200)))
+    o = np.moveaxis(ortho[:, ::step, ::step], 0, -1)
+    fig, ax = plt.subplots(figsize=(7, 6))
+    if o.shape[2] >= 4:
+        rgb = o[:, :, :3].astype(np.float32)
+        if rgb.max() > 255:
+            rgb = rgb / max(float(rgb.max()), 1.0) * 255
+        alpha = o[:, :, -1] > 0
+        show = np.where(alpha[..., None], rgb, 0).astype(np.uint8)
+    else:
+        show = o[:, :, 0]
+    oext = (og.extent[0], og.extent[2], og.extent[1], og.extent[3])
+    ax.imshow(show, extent=oext)
+    ax.set_title(f"True orthophoto (black: seen by no image, {100 * occl:.2f} %)")
+    report.add_figure("True orthophoto preview", fig)
+    report.tables.append(Table(_CHAIN_TABLES[1], ["stage", "time [s]", "peak memory [MB]", "result"], []))
+    return report
 
 
 def _fmt(v) -> str:

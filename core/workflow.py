@@ -28,7 +28,6 @@ it ends; a local cluster thus starts once for the three stages.
 from __future__ import annotations
 
 import dataclasses
-import json
 import os
 import time
 from dataclasses import dataclass, field
@@ -40,7 +39,7 @@ import numpy as np
 from .errors import InputError
 from .memory import peak_rss_mb
 from .progress import EtaProgress, Progress, Steps, as_progress, check
-from .report import Report, Table
+from .report import Report, pipeline_report, reused_orientation_report
 
 #: Product names in the output folder.
 PRODUCTS = {
@@ -193,6 +192,7 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
     from .orientation import Orientation
     from .ortho.pipeline import true_ortho
     from .osgm import OsgmOutputs, run_osgm
+    from .rasterio_io import write_seamlines
     from .sfm.pipeline import OrientConfig, orient_images
     from .surface.filter import DsmFilterConfig, filter_dsm
     from .surface.mesh import DsmMeshConfig, mesh_from_dsm
@@ -207,7 +207,6 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
     # every stage's messages carry its elapsed time and an estimate of its time left
     steps = [EtaProgress(stage_steps[k]) for k in range(len(weights))]
     stages = _Stages()
-    report = Report("TruOrtho pipeline report")
     t0 = time.perf_counter()
 
     # 1. orientation
@@ -215,7 +214,7 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
     reuse = cfg.reuse_orientation and Path(paths["orientation"]).exists()
     if reuse:
         orientation = Orientation.load(paths["orientation"])
-        orient_report = _previous_orientation_report(folder)
+        orient_report = reused_orientation_report(folder / "report.json")
         stages.stop("reused orientation.json")
     else:
         if not images:
@@ -275,7 +274,10 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
 
     # 6. report
     stages.start("report")
-    _fill_report(report, orient_report, orientation, osgm, fstats, paths, tres, stages, reuse)
+    report = pipeline_report(
+        "TruOrtho pipeline report", orient_report, orientation, osgm, fstats, paths["dsm"],
+        paths["trueortho"], tres, reuse,
+    )  # fmt: skip
     ran_on = executor.describe() if hasattr(executor, "describe") else type(executor).__name__
     report.summary["tiles ran on"] = ran_on
     stages.stop()
@@ -294,119 +296,3 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
     }
     progress.update(1.0, "pipeline done")
     return WorkflowResult(paths, stats, report)
-
-
-def write_seamlines(path, regions, crs) -> None:
-    """Seamline polygons (one feature per source image) as a GeoPackage, atomically."""
-    from osgeo import ogr, osr
-
-    from .rasterio_io import atomic_output
-
-    with atomic_output(path) as tmp:
-        drv = ogr.GetDriverByName("GPKG")
-        ds = drv.CreateDataSource(str(tmp))
-        srs = osr.SpatialReference()
-        if crs:
-            srs.SetFromUserInput(str(crs))
-            srs.SetAxisMappingStrategy(osr.OAMS_TRADITIONAL_GIS_ORDER)
-        layer = ds.CreateLayer("seamlines", srs if crs else None, ogr.wkbMultiPolygon)
-        for name, kind in (("image", ogr.OFTInteger), ("name", ogr.OFTString), ("cells", ogr.OFTInteger)):
-            layer.CreateField(ogr.FieldDefn(name, kind))
-        for r in regions:
-            f = ogr.Feature(layer.GetLayerDefn())
-            geom = ogr.ForceToMultiPolygon(ogr.CreateGeometryFromWkt(r.wkt))
-            f.SetGeometry(geom)
-            f.SetField("image", int(r.image_index))
-            f.SetField("name", str(r.image_name))
-            f.SetField("cells", int(r.cells))
-            layer.CreateFeature(f)
-        ds = None  # close before the rename
-        del ds
-
-
-def _previous_orientation_report(folder: Path) -> Report | None:
-    p = folder / "report.json"
-    if not p.exists():
-        return None
-    try:
-        d = json.loads(p.read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    rep = Report("orientation (reused)")
-    for t in d.get("tables", []):
-        if str(t.get("title", "")).startswith("Stage"):
-            continue
-        rep.tables.append(Table(t["title"], t["columns"], t["rows"], t.get("note", "")))
-    this_run = ("DSM", "true", "total", "tiles")  # the rest of the chain, not the orientation
-    rep.summary = {k: v for k, v in d.get("summary", {}).items() if not str(k).startswith(this_run)}
-    return rep
-
-
-def _fill_report(
-    report: Report, orient_report, orientation, osgm, fstats, paths, tres, stages, reused
-) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from .rasterio_io import read_raster
-
-    if orient_report is not None:
-        report.data["orientation"] = orient_report.data
-        report.summary.update(orient_report.summary)
-        report.tables.extend(orient_report.tables)
-        report.figures.extend(orient_report.figures)
-        report.warnings.extend(orient_report.warnings)
-    if reused:
-        report.warnings.append("The orientation was reused from orientation.json (not recomputed).")
-    report.summary["images oriented"] = len(orientation.images)
-    report.summary["CRS"] = orientation.crs
-    s = osgm.stats
-    report.data["osgm"] = s
-    report.data["filter"] = fstats.as_dict()
-    report.data["trueortho"] = {k: v for k, v in tres.stats.items() if isinstance(v, int | float | str)}
-    report.summary["DSM resolution [m]"] = s["resolution"]
-    report.summary["DSM completeness (raw) [%]"] = round(100 * s["completeness"], 2)
-    dsm, grid, _ = read_raster(paths["dsm"])
-    report.summary["DSM completeness (filtered) [%]"] = round(100 * float(np.isfinite(dsm).mean()), 2)
-    st = tres.stats
-    occl = float(st.get("cells_occluded", 0)) / max(1, int(st.get("rows", 1)) * int(st.get("cols", 1)))
-    report.summary["true ortho coverage [%]"] = round(100 * float(st["coverage"]), 2)
-    report.summary["true ortho occluded share [%]"] = round(100 * occl, 2)
-    report.tables.append(
-        Table("Dense matching and DSM filter", ["what", "value"],
-              [["OSGM", osgm.summary()], ["filter", fstats.summary()]])
-    )  # fmt: skip
-    # DSM hillshade
-    fig, ax = plt.subplots(figsize=(7, 6))
-    z = np.where(np.isfinite(dsm), dsm, np.nanmedian(dsm) if np.isfinite(dsm).any() else 0)
-    gy, gx = np.gradient(z, grid.res)
-    slope = np.pi / 2 - np.arctan(np.hypot(gx, gy))
-    aspect = np.arctan2(-gx, gy)
-    az, alt = np.radians(315), np.radians(45)
-    shade = np.sin(alt) * np.sin(slope) + np.cos(alt) * np.cos(slope) * np.cos(az - aspect)
-    ext = (grid.extent[0], grid.extent[2], grid.extent[1], grid.extent[3])
-    ax.imshow(np.where(np.isfinite(dsm), shade, np.nan), cmap="gray", extent=ext)
-    im = ax.imshow(np.where(np.isfinite(dsm), dsm, np.nan), cmap="terrain", alpha=0.45, extent=ext)
-    fig.colorbar(im, ax=ax, label="height [m]")
-    ax.set_title(f"Filtered DSM ({100 * float(np.isfinite(dsm).mean()):.1f} % of the cells)")
-    report.add_figure("DSM hillshade (filtered DSM)", fig)
-    # true ortho preview
-    ortho, og, _ = read_raster(paths["trueortho"], band=None)
-    step = max(1, int(np.ceil(max(ortho.shape[1:]) / 1200)))
-    o = np.moveaxis(ortho[:, ::step, ::step], 0, -1)
-    fig, ax = plt.subplots(figsize=(7, 6))
-    if o.shape[2] >= 4:
-        rgb = o[:, :, :3].astype(np.float32)
-        if rgb.max() > 255:
-            rgb = rgb / max(float(rgb.max()), 1.0) * 255
-        alpha = o[:, :, -1] > 0
-        show = np.where(alpha[..., None], rgb, 0).astype(np.uint8)
-    else:
-        show = o[:, :, 0]
-    oext = (og.extent[0], og.extent[2], og.extent[1], og.extent[3])
-    ax.imshow(show, extent=oext)
-    ax.set_title(f"True orthophoto (black: seen by no image, {100 * occl:.2f} %)")
-    report.add_figure("True orthophoto preview", fig)
-    report.tables.append(Table("Stages", ["stage", "time [s]", "peak memory [MB]", "result"], []))
