@@ -354,46 +354,65 @@ def _solve(N: np.ndarray, b: np.ndarray):
 
 
 def _lsm_stage(t, window, ox, oy, p, r, cfg, start, it0):
-    """Gauss-Newton iterations on one (possibly blurred) stage; returns (p, r, it, reason, extras)."""
+    """Levenberg-Marquardt iterations on one (possibly blurred) stage.
+
+    Returns ``(p, r, it, reason, extras)``; a step that does not lower the residuals is retried
+    with more damping (symmetric targets otherwise make the shaping oscillate).
+    """
     gx, gy = _gradients(window)
     local = _PROJECTIVE_LOCAL if cfg.projective else _AFFINE_LOCAL
     idx = np.concatenate([local, _SHIFT])
+    shape_idx = np.arange(len(local) - 2)
     N = np.zeros((10, 10))
     b = np.zeros(10)
+    Nt = np.zeros((10, 10))
+    bt = np.zeros(10)
     res = np.zeros(t.shape)
     pc = p.copy()
     pc[8] -= ox
     pc[9] -= oy
     it = it0
-    sol = None
-    ssr, n = 0.0, 0
+    lam = 1e-3
+    done = False
+    ssr, n, outside = _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
+    if outside:
+        return pc, r, it, "left the image", None
     for _ in range(cfg.max_iterations):
         it += 1
-        ssr, n, outside = _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
-        if outside:
-            return pc, r, it, "left the image", None
-        shape_idx = np.arange(len(local) - 2)
-        sol = _solve(_damped(N[np.ix_(idx, idx)], shape_idx), b[idx])
-        if sol is None:
-            return pc, r, it, "singular (no texture)", None
-        d = sol[0]
-        full = np.zeros(10)
-        full[idx] = d
-        pc[:6] += full[:6]
-        r = (r[0] + full[6], r[1] + full[7])
-        pc[8] += full[8]
-        pc[9] += full[9]
-        if not np.all(np.isfinite(pc)) or r[1] <= 0:
-            return pc, r, it, "diverged", None
+        Ns = _damped(N[np.ix_(idx, idx)], shape_idx)
+        accepted = False
+        step = np.inf
+        for _attempt in range(10):
+            Nd = Ns.copy()
+            Nd[np.diag_indices_from(Nd)] *= 1.0 + lam
+            sol = _solve(Nd, b[idx])
+            if sol is None:
+                return pc, r, it, "singular (no texture)", None
+            full = np.zeros(10)
+            full[idx] = sol[0]
+            trial = pc.copy()
+            trial[:6] += full[:6]
+            trial[8:] += full[8:]
+            rt = (r[0] + full[6], r[1] + full[7])
+            if np.all(np.isfinite(trial)) and rt[1] > 0:
+                ssr_t, n_t, out_t = _normals(t, window, gx, gy, trial, rt[0], rt[1], Nt, bt, res)
+                if not out_t and ssr_t <= ssr:
+                    pc, r, ssr, n = trial, rt, ssr_t, n_t
+                    N[:], b[:] = Nt, bt
+                    lam = max(lam * 0.3, 1e-7)
+                    accepted = True
+                    step = math.hypot(full[8], full[9])
+                    break
+            lam *= 10.0
+        if not accepted:
+            done = True  # no step lowers the residuals: at the minimum
         if math.hypot(pc[8] + ox - start[0], pc[9] + oy - start[1]) > cfg.max_shift:
             return pc, r, it, "moved farther than max_shift", None
         det = pc[0] * pc[3] - pc[1] * pc[2]
         if not 0.1 < abs(det) < 10.0:
             return pc, r, it, "degenerate shape", None
-        if math.hypot(full[8], full[9]) < cfg.tolerance:
-            ssr, n, outside = _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
-            if outside:
-                return pc, r, it, "left the image", None
+        if done or step < cfg.tolerance:
+            _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
             sol = _solve(N[np.ix_(idx, idx)], b[idx]) or _solve(
                 _damped(N[np.ix_(idx, idx)], shape_idx), b[idx]
             )
