@@ -29,6 +29,7 @@ from qgis.PyQt.QtWidgets import (
     QFileDialog,
     QFormLayout,
     QHBoxLayout,
+    QHeaderView,
     QLabel,
     QLineEdit,
     QSplitter,
@@ -175,7 +176,7 @@ class GcpPanel(QDockWidget):
         self.table.setSelectionMode(QAbstractItemView.SingleSelection)
         self.table.cellClicked.connect(self._cell_clicked)
         self.table.currentCellChanged.connect(lambda r, c, _r, _c: self._cell_clicked(r, c))
-        self.table.horizontalHeader().setDefaultSectionSize(36)
+        self.table.horizontalHeader().setSectionResizeMode(QHeaderView.ResizeToContents)
         split.addWidget(self.table)
         viewer = QWidget()
         vl = QVBoxLayout(viewer)
