@@ -114,6 +114,9 @@ class GcpPanel(QDockWidget):
         self.current_image: str | None = None
         self.last_message: tuple[str, str] | None = None
         self.table_layer: QgsVectorLayer | None = None
+        #: The last observation table saved (CSV): the file behind the table layer when there is one.
+        self.csv_path: str | None = None
+        self._layer_csv: str | None = None
         self._build()
 
     # ------------------------------------------------------------ widgets
@@ -209,7 +212,9 @@ class GcpPanel(QDockWidget):
             self._button(tr("Save gcp_list…"), tr("Save as ODM gcp_list.txt"), self._browse_save_list)
         )
         row.addWidget(
-            self._button(tr("Add table layer"), tr("Keep the measurements as a table layer in the project"),
+            self._button(tr("Add table layer"),
+                         tr("Keep the measurements as a table layer in the project: the saved CSV table, "
+                            "rewritten as you measure (a temporary layer until a table is saved)"),
                          self.add_table_layer)
         )  # fmt: skip
         row.addStretch(1)
@@ -549,6 +554,7 @@ class GcpPanel(QDockWidget):
         """Save the observation table (CSV); False with a message on failure (the old file is kept)."""
         ok = self._file_op(lambda p: self.model.save_csv(p), path)  # type: ignore[union-attr]
         if ok:
+            self.csv_path = path
             self.show_message(tr("Saved {} measurements to {}").format(len(self.model), path), Qgis.Success)
         return ok
 
@@ -579,14 +585,28 @@ class GcpPanel(QDockWidget):
 
     # ------------------------------------------------------------ table layer
     def add_table_layer(self) -> QgsVectorLayer | None:
-        """A memory table layer of the measurements in the project, kept up to date by the panel."""
+        """The measurements as a table layer in the project, kept up to date by the panel.
+
+        After *Save table…* it is the saved CSV (an ordinary file layer, stored with the project),
+        which the panel rewrites (atomically) after every change; before, a memory layer.
+        """
         if self.model is None:
             self.show_message(tr("Load the images and the GCPs first."))
             return None
-        if self._layer_alive():
+        if self._layer_alive() and (self._layer_csv == self.csv_path or self.csv_path is None):
             return self.table_layer
-        uri = "None?" + "&".join(f"field={n}:{t}" for n, t in LAYER_FIELDS)
-        layer = QgsVectorLayer(uri, tr("GCP observations"), "memory")
+        if self._layer_alive():  # a memory layer, now that a table is saved: replace it by the file
+            QgsProject.instance().removeMapLayer(self.table_layer.id())  # type: ignore[union-attr]
+        layer = None
+        if self.csv_path:
+            layer = QgsVectorLayer(self.csv_path, tr("GCP observations"), "ogr")
+            if not layer.isValid():
+                self.show_message(tr("Cannot open {} as a table layer").format(self.csv_path), Qgis.Critical)
+                layer = None
+        self._layer_csv = self.csv_path if layer is not None else None
+        if layer is None:
+            uri = "None?" + "&".join(f"field={n}:{t}" for n, t in LAYER_FIELDS)
+            layer = QgsVectorLayer(uri, tr("GCP observations"), "memory")
         self.table_layer = layer
         self._sync_layer()
         QgsProject.instance().addMapLayer(layer)
@@ -610,6 +630,15 @@ class GcpPanel(QDockWidget):
             provider = layer.dataProvider()
         except RuntimeError:
             self.table_layer = None
+            return
+        if self._layer_csv is not None:
+            try:
+                m.save_csv(self._layer_csv)
+            except (TruOrthoError, OSError) as err:
+                self.show_message(str(err), Qgis.Critical)
+                return
+            provider.reloadData()
+            layer.triggerRepaint()
             return
         provider.deleteFeatures([f.id() for f in layer.getFeatures()])
         feats = []

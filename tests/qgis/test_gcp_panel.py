@@ -245,6 +245,20 @@ def test_table_layer_follows_the_measurements(panel, block):
     gcps = read_gcp_layer(block["layer"], None, QgsProject.instance().transformContext())
     read_observation_table(layer, gcps, {p.name for p in m.photos})
     assert [g.observations for g in gcps if g.name == "C"] == [[(m.photos[2].name, 12.5, 7.25)]]
+    # once a table is saved, the layer is that CSV file (stored with the project), rewritten as one measures
+    csv_path = block["tmp"] / "kept.csv"
+    assert panel.save_csv(str(csv_path))
+    memory_id = layer.id()
+    kept = panel.add_table_layer()
+    assert kept.providerType() == "ogr" and QgsProject.instance().mapLayer(memory_id) is None  # replaced
+    panel.select("A", m.photos[0].name)
+    assert panel.place_at(3.125, 4.5)
+    assert "A," + m.photos[0].name + ",3.125,4.5" in csv_path.read_text()
+    gcps = read_gcp_layer(block["layer"], None, QgsProject.instance().transformContext())
+    read_observation_table(kept, gcps, {p.name for p in m.photos})
+    obs = {g.name: g.observations for g in gcps}
+    assert obs["A"] == [(m.photos[0].name, 3.125, 4.5)] and obs["C"] == [(m.photos[2].name, 12.5, 7.25)]
+    assert panel.undo() and kept.featureCount() == 1 and "3.125" not in csv_path.read_text()
 
 
 def test_plugin_action_shows_the_dock(qgis_iface, truortho_plugin):
