@@ -30,6 +30,7 @@ import cv2
 import numpy as np
 
 from ..errors import InputError
+from ..progress import Progress
 from ..synthetic.targets import checker_pattern, disc_pattern, render_homography
 from .lsm import LsmConfig, LsmResult, lsm_match
 
@@ -407,3 +408,110 @@ def _scale_about(n_pattern: int, n_template: int) -> np.ndarray:
     s = 1.5 * n_template / n_pattern
     c_p, c_t = (n_pattern - 1) / 2.0, (n_template - 1) / 2.0
     return np.array([[s, 0.0, c_t - s * c_p], [0.0, s, c_t - s * c_p], [0.0, 0.0, 1.0]])
+
+
+# ---------------------------------------------------------------- a folder
+
+
+@dataclass(frozen=True)
+class TargetDetection:
+    """Result of :func:`detect_targets`: the measurements (low scores included, flagged), the
+    warnings for a report (unmapped marker IDs, GCPs never found) and the number of images."""
+
+    measurements: list[TargetMeasurement]
+    warnings: list[str]
+    images: int
+
+
+def detect_targets(
+    folder,
+    config: TargetConfig | None = None,
+    names: dict[int, str] | None = None,
+    predictions=None,
+    progress: Progress | None = None,
+) -> TargetDetection:
+    """Detect targets in every image of a folder.
+
+    Parameters
+    ----------
+    folder : str or os.PathLike
+        Folder of the images (:func:`truortho.core.gcp.measurements.list_images`).
+    config : TargetConfig, optional
+    names : dict int -> str
+        ArUco marker ID -> GCP name; required for ``target = "aruco"``.
+    predictions : sequence of :class:`~truortho.core.gcp.measurements.Prediction`
+        Predicted pixel of each GCP in each image (from an orientation); required for circle and
+        checker targets, which are searched within ``search_radius`` of them. Ignored for ArUco.
+    progress : Progress, optional
+        Per image; cancel between images.
+
+    Returns
+    -------
+    TargetDetection
+
+    Raises
+    ------
+    InputError
+        Bad folder, a missing mapping or missing predictions, a prediction for an image that is
+        not in the folder.
+    """
+    from ..imagery import luminance, read_image
+    from ..progress import as_progress, check
+    from .measurements import list_images
+
+    cfg = config or TargetConfig()
+    photos = list_images(folder)
+    prog = as_progress(progress)
+    warnings: list[str] = []
+    out: list[TargetMeasurement] = []
+    by_image: dict[str, list] = {}
+    if cfg.target == "aruco":
+        if not names:
+            raise InputError("ArUco targets need the marker mapping 'ID=NAME' (e.g. 0=GCP1,1=GCP2)")
+    else:
+        if not predictions:
+            raise InputError(
+                f"{cfg.target} targets are searched near predicted positions: give an orientation and "
+                "GCPs that project into the images"
+            )
+        known = {p.name for p in photos}
+        for pr in predictions:
+            if pr.image not in known:
+                raise InputError(
+                    f"prediction of GCP {pr.gcp!r} on image {pr.image!r}, which is not in the folder"
+                )
+            by_image.setdefault(pr.image, []).append(pr)
+    unmapped: dict[int, list[str]] = {}
+    for k, photo in enumerate(photos):
+        check(prog)
+        prog.update(k / len(photos), f"{photo.name}: looking for {cfg.target} targets")
+        if cfg.target != "aruco" and photo.name not in by_image:
+            continue
+        gray = luminance(read_image(photo.path))
+        if cfg.target == "aruco":
+            found, ids = detect_aruco(gray, names or {}, photo.name, cfg)
+            out.extend(found)
+            for i in ids:
+                unmapped.setdefault(i, []).append(photo.name)
+            continue
+        detect = detect_circle if cfg.target == "circle" else detect_checker
+        for pr in by_image[photo.name]:
+            m = detect(gray, pr.x, pr.y, pr.gcp, photo.name, cfg)
+            if m is None:
+                warnings.append(
+                    f"{photo.name}: no {cfg.target} target of GCP {pr.gcp!r} within {cfg.search_radius:g} px "
+                    f"of its predicted position ({pr.x:.1f}, {pr.y:.1f})"
+                )
+            else:
+                out.append(m)
+    prog.update(1.0, f"{len(out)} measurements in {len(photos)} images")
+    for i, imgs in sorted(unmapped.items()):
+        warnings.append(f"marker ID {i} (not in the mapping) seen in {len(imgs)} image(s), e.g. {imgs[0]}")
+    seen = {m.gcp for m in out}
+    expected = set(names.values()) if cfg.target == "aruco" and names else {p.gcp for p in predictions or []}
+    for g in sorted(expected - seen):
+        warnings.append(f"GCP {g!r} was not found in any image")
+    low = sum(m.flag != "ok" for m in out)
+    if low:
+        warnings.append(f"{low} measurement(s) flagged (low score or failed refinement): check them")
+    return TargetDetection(out, warnings, len(photos))

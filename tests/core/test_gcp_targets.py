@@ -118,3 +118,33 @@ def test_nothing_there_and_bad_input():
         TargetConfig(dictionary="DICT_9X9")
     with pytest.raises(InputError):
         detect_aruco(np.zeros((4, 4)), {0: "A"})
+
+
+def test_detect_targets_in_a_folder(tmp_path):
+    from truortho.core.gcp.measurements import Prediction
+    from truortho.core.gcp.targets import detect_targets
+
+    truths = {}
+    for seed in (0, 1):
+        img, truth = aruco_scene(seed, ids=(0, 5))
+        cv2.imwrite(str(tmp_path / f"img_{seed}.png"), img)
+        truths[f"img_{seed}.png"] = truth
+    (tmp_path / "notes.txt").write_text("not an image")
+    res = detect_targets(tmp_path, TargetConfig(), {0: "G0", 9: "G9"})
+    assert res.images == 2
+    assert sorted((m.image, m.gcp) for m in res.measurements) == [("img_0.png", "G0"), ("img_1.png", "G0")]
+    for m in res.measurements:
+        t = truths[m.image][0]
+        assert np.hypot(m.x - t[0], m.y - t[1]) < 0.2
+    text = " ".join(res.warnings)
+    assert "marker ID 5" in text and "'G9' was not found" in text
+    with pytest.raises(InputError, match="mapping"):
+        detect_targets(tmp_path, TargetConfig(), {})
+    with pytest.raises(InputError, match="not a folder"):
+        detect_targets(tmp_path / "missing", TargetConfig(), {0: "G0"})
+    with pytest.raises(InputError, match="predicted"):
+        detect_targets(tmp_path, TargetConfig(target="circle"))
+    with pytest.raises(InputError, match="not in the folder"):
+        detect_targets(
+            tmp_path, TargetConfig(target="circle"), predictions=[Prediction("G0", "x.png", 5, 5, 10)]
+        )
