@@ -1799,264 +1799,269 @@
             <translation>von keinem Bild gesehen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="202" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="206" />
             <source>Load measurements from a CSV table or gcp_list.txt</source>
             <translation>Messungen aus einer CSV-Tabelle oder gcp_list.txt laden</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="106" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="107" />
             <source>GCP measurements</source>
             <translation>GCP-Messungen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="136" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="140" />
             <source>Folder of the photos</source>
             <translation>Ordner der Fotos</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="140" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="144" />
             <source>Images</source>
             <translation>Bilder</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="144" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="148" />
             <source>GCP layer</source>
             <translation>GCP-Layer</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="147" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="151" />
             <source>Optional: orientation to predict the GCPs in the images</source>
             <translation>Optional: Orientierung, um die GCPs in den Bildern vorherzusagen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="157" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
             <source>Load</source>
             <translation>Laden</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="157" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
             <source>Read the images, the GCPs and the orientation</source>
             <translation>Bilder, GCPs und Orientierung einlesen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="165" />
             <source>Undo</source>
             <translation>Rückgängig</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="165" />
             <source>Undo (Ctrl+Z)</source>
             <translation>Rückgängig (Strg+Z)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="162" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="166" />
             <source>Redo</source>
             <translation>Wiederholen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="162" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="166" />
             <source>Redo (Ctrl+Shift+Z)</source>
             <translation>Wiederholen (Strg+Umschalt+Z)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="164" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="168" />
             <source>Delete</source>
             <translation>Löschen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="165" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="169" />
             <source>Delete the measurement of the current GCP in this image (Del)</source>
             <translation>Messung des aktuellen GCP in diesem Bild löschen (Entf)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="193" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="197" />
             <source>Click: place the current GCP; drag: pan; wheel: zoom</source>
             <translation>Klick: aktuellen GCP setzen; Ziehen: verschieben; Mausrad: zoomen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="245" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="251" />
             <source>Orientations (*.json *.txt);;All files (*)</source>
             <translation>Orientierungen (*.json *.txt);;Alle Dateien (*)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="348" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="354" />
             <source>predicted</source>
             <translation>vorhergesagt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="348" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="354" />
             <source>not measured</source>
             <translation>nicht gemessen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="516" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
             <source>Save the observation table</source>
             <translation>Beobachtungstabelle speichern</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="516" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
             <source>CSV (*.csv)</source>
             <translation>CSV (*.csv)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="528" />
             <source>Save gcp_list.txt</source>
             <translation>gcp_list.txt speichern</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="523" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="529" />
             <source>gcp_list (*.txt)</source>
             <translation>gcp_list (*.txt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="528" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="534" />
             <source>Open measurements</source>
             <translation>Messungen öffnen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="529" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="535" />
             <source>Observation tables (*.csv *.txt)</source>
             <translation>Beobachtungstabellen (*.csv *.txt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="588" />
-            <source>GCP observations</source>
-            <translation>GCP-Beobachtungen</translation>
-        </message>
-        <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="139" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="143" />
             <source>Choose the image folder</source>
             <translation>Bildordner wählen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="151" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="155" />
             <source>Choose an orientation file</source>
             <translation>Orientierungsdatei wählen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="184" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
             <source>Previous image (Page Up)</source>
             <translation>Vorheriges Bild (Bild auf)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="185" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="189" />
             <source>Next image (Page Down)</source>
             <translation>Nächstes Bild (Bild ab)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="186" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="190" />
             <source>Previous GCP (Ctrl+Page Up)</source>
             <translation>Vorheriger GCP (Strg+Bild auf)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="187" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="191" />
             <source>Next GCP (Ctrl+Page Down)</source>
             <translation>Nächster GCP (Strg+Bild ab)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="192" />
             <source>Fit</source>
             <translation>Einpassen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="192" />
             <source>Show the whole image (F)</source>
             <translation>Ganzes Bild zeigen (F)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="203" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="207" />
             <source>Open table…</source>
             <translation>Tabelle öffnen…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="205" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="209" />
             <source>Save table…</source>
             <translation>Tabelle speichern…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="205" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="209" />
             <source>Save the observation table (CSV)</source>
             <translation>Beobachtungstabelle speichern (CSV)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="208" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
             <source>Save gcp_list…</source>
             <translation>gcp_list speichern…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="208" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
             <source>Save as ODM gcp_list.txt</source>
             <translation>Als ODM-gcp_list.txt speichern</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="211" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="215" />
             <source>Add table layer</source>
             <translation>Tabellenlayer hinzufügen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="211" />
-            <source>Keep the measurements as a table layer in the project</source>
-            <translation>Messungen als Tabellenlayer im Projekt behalten</translation>
+            <location filename="../truortho_plugin/gcp_panel.py" line="216" />
+            <source>Keep the measurements as a table layer in the project: the saved CSV table, rewritten as you measure (a temporary layer until a table is saved)</source>
+            <translation>Messungen als Tabellenlayer im Projekt behalten: die gespeicherte CSV-Tabelle, beim Messen laufend neu geschrieben (bis eine Tabelle gespeichert ist, ein temporärer Layer)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="268" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="274" />
             <source>Choose the folder of the photos first.</source>
             <translation>Zuerst den Ordner der Fotos wählen.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="271" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="277" />
             <source>Choose a GCP point layer first (fields: name, optional role and z).</source>
             <translation>Zuerst einen GCP-Punktlayer wählen (Felder: name, optional role und z).</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="295" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="301" />
             <source>{} GCPs, {} images</source>
             <translation>{} GCPs, {} Bilder</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="438" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="444" />
             <source>Load the images and the GCPs first.</source>
             <translation>Zuerst die Bilder und die GCPs laden.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="297" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="602" />
+            <source>GCP observations</source>
+            <translation>GCP-Beobachtungen</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="303" />
             <source>; {} predicted positions</source>
             <translation>; {} vorhergesagte Positionen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="499" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="505" />
             <source>{} on {}: {} — {} measured, {} to do — zoom {:.2f}</source>
             <translation>{} in {}: {} — {} gemessen, {} offen — Zoom {:.2f}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="318" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="324" />
             <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</source>
             <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="319" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="325" />
             <source> (check point)</source>
             <translation> (Kontrollpunkt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="551" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="558" />
             <source>Saved {} measurements to {}</source>
             <translation>{} Messungen in {} gespeichert</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="576" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="583" />
             <source>Loaded {} measurements from {}</source>
             <translation>{} Messungen aus {} geladen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="277" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="283" />
             <source>GCP layer {!r} has no point</source>
             <translation>GCP-Layer {!r} enthält keinen Punkt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="380" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="386" />
             <source>Cannot read the image {}</source>
             <translation>Das Bild {} kann nicht gelesen werden</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="604" />
+            <source>Cannot open {} as a table layer</source>
+            <translation>{} kann nicht als Tabellenlayer geöffnet werden</translation>
         </message>
         <message>
             <location filename="../truortho_plugin/plugin.py" line="15" />
@@ -2102,6 +2107,10 @@
             <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>Der Algorithmus {} ist in dieser Version nicht verfügbar.</translation>
+        </message>
+        <message>
+            <source>Keep the measurements as a table layer in the project</source>
+            <translation type="obsolete">Messungen als Tabellenlayer im Projekt behalten</translation>
         </message>
         <message>
             <source>GeoTIFF with the images' bands and data type plus an alpha band, tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>

@@ -1799,264 +1799,269 @@
             <translation>vu par aucune image</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="202" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="206" />
             <source>Load measurements from a CSV table or gcp_list.txt</source>
             <translation>Charger les mesures depuis une table CSV ou un gcp_list.txt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="106" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="107" />
             <source>GCP measurements</source>
             <translation>Mesures des points d'appui</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="136" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="140" />
             <source>Folder of the photos</source>
             <translation>Dossier des photos</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="140" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="144" />
             <source>Images</source>
             <translation>Images</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="144" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="148" />
             <source>GCP layer</source>
             <translation>Couche des points d'appui</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="147" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="151" />
             <source>Optional: orientation to predict the GCPs in the images</source>
             <translation>Facultatif : orientation pour prédire les points d'appui dans les images</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="157" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
             <source>Load</source>
             <translation>Charger</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="157" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
             <source>Read the images, the GCPs and the orientation</source>
             <translation>Lire les images, les points d'appui et l'orientation</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="165" />
             <source>Undo</source>
             <translation>Annuler</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="161" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="165" />
             <source>Undo (Ctrl+Z)</source>
             <translation>Annuler (Ctrl+Z)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="162" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="166" />
             <source>Redo</source>
             <translation>Rétablir</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="162" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="166" />
             <source>Redo (Ctrl+Shift+Z)</source>
             <translation>Rétablir (Ctrl+Maj+Z)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="164" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="168" />
             <source>Delete</source>
             <translation>Supprimer</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="165" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="169" />
             <source>Delete the measurement of the current GCP in this image (Del)</source>
             <translation>Supprimer la mesure du point d'appui courant dans cette image (Suppr)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="193" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="197" />
             <source>Click: place the current GCP; drag: pan; wheel: zoom</source>
             <translation>Clic : placer le point d'appui courant ; glisser : déplacer la vue ; molette : zoomer</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="245" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="251" />
             <source>Orientations (*.json *.txt);;All files (*)</source>
             <translation>Orientations (*.json *.txt);;Tous les fichiers (*)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="348" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="354" />
             <source>predicted</source>
             <translation>prédit</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="348" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="354" />
             <source>not measured</source>
             <translation>non mesuré</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="516" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
             <source>Save the observation table</source>
             <translation>Enregistrer la table des observations</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="516" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
             <source>CSV (*.csv)</source>
             <translation>CSV (*.csv)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="528" />
             <source>Save gcp_list.txt</source>
             <translation>Enregistrer gcp_list.txt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="523" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="529" />
             <source>gcp_list (*.txt)</source>
             <translation>gcp_list (*.txt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="528" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="534" />
             <source>Open measurements</source>
             <translation>Ouvrir des mesures</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="529" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="535" />
             <source>Observation tables (*.csv *.txt)</source>
             <translation>Tables d'observations (*.csv *.txt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="588" />
-            <source>GCP observations</source>
-            <translation>Observations des points d'appui</translation>
-        </message>
-        <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="139" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="143" />
             <source>Choose the image folder</source>
             <translation>Choisir le dossier des images</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="151" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="155" />
             <source>Choose an orientation file</source>
             <translation>Choisir un fichier d'orientation</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="184" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
             <source>Previous image (Page Up)</source>
             <translation>Image précédente (Page préc.)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="185" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="189" />
             <source>Next image (Page Down)</source>
             <translation>Image suivante (Page suiv.)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="186" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="190" />
             <source>Previous GCP (Ctrl+Page Up)</source>
             <translation>Point d'appui précédent (Ctrl+Page préc.)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="187" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="191" />
             <source>Next GCP (Ctrl+Page Down)</source>
             <translation>Point d'appui suivant (Ctrl+Page suiv.)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="192" />
             <source>Fit</source>
             <translation>Ajuster</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="192" />
             <source>Show the whole image (F)</source>
             <translation>Afficher l'image entière (F)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="203" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="207" />
             <source>Open table…</source>
             <translation>Ouvrir une table…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="205" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="209" />
             <source>Save table…</source>
             <translation>Enregistrer la table…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="205" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="209" />
             <source>Save the observation table (CSV)</source>
             <translation>Enregistrer la table des observations (CSV)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="208" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
             <source>Save gcp_list…</source>
             <translation>Enregistrer gcp_list…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="208" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
             <source>Save as ODM gcp_list.txt</source>
             <translation>Enregistrer au format ODM gcp_list.txt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="211" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="215" />
             <source>Add table layer</source>
             <translation>Ajouter une couche table</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="211" />
-            <source>Keep the measurements as a table layer in the project</source>
-            <translation>Conserver les mesures comme couche table dans le projet</translation>
+            <location filename="../truortho_plugin/gcp_panel.py" line="216" />
+            <source>Keep the measurements as a table layer in the project: the saved CSV table, rewritten as you measure (a temporary layer until a table is saved)</source>
+            <translation>Conserver les mesures comme couche table dans le projet : la table CSV enregistrée, réécrite au fil des mesures (une couche temporaire tant qu'aucune table n'est enregistrée)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="268" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="274" />
             <source>Choose the folder of the photos first.</source>
             <translation>Choisissez d'abord le dossier des photos.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="271" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="277" />
             <source>Choose a GCP point layer first (fields: name, optional role and z).</source>
             <translation>Choisissez d'abord une couche de points d'appui (champs : name, role et z facultatifs).</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="295" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="301" />
             <source>{} GCPs, {} images</source>
             <translation>{} points d'appui, {} images</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="438" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="444" />
             <source>Load the images and the GCPs first.</source>
             <translation>Chargez d'abord les images et les points d'appui.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="297" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="602" />
+            <source>GCP observations</source>
+            <translation>Observations des points d'appui</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="303" />
             <source>; {} predicted positions</source>
             <translation> ; {} positions prédites</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="499" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="505" />
             <source>{} on {}: {} — {} measured, {} to do — zoom {:.2f}</source>
             <translation>{} sur {} : {} — {} mesurées, {} à faire — zoom {:.2f}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="318" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="324" />
             <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</source>
             <translation>{} : X {:.3f}, Y {:.3f}, Z {:.3f}{}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="319" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="325" />
             <source> (check point)</source>
             <translation> (point de contrôle)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="551" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="558" />
             <source>Saved {} measurements to {}</source>
             <translation>{} mesures enregistrées dans {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="576" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="583" />
             <source>Loaded {} measurements from {}</source>
             <translation>{} mesures chargées depuis {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="277" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="283" />
             <source>GCP layer {!r} has no point</source>
             <translation>La couche de points d'appui {!r} ne contient aucun point</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="380" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="386" />
             <source>Cannot read the image {}</source>
             <translation>Impossible de lire l'image {}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="604" />
+            <source>Cannot open {} as a table layer</source>
+            <translation>Impossible d'ouvrir {} comme couche table</translation>
         </message>
         <message>
             <location filename="../truortho_plugin/plugin.py" line="15" />
@@ -2102,6 +2107,10 @@
             <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>L'algorithme {} n'est pas disponible dans cette version.</translation>
+        </message>
+        <message>
+            <source>Keep the measurements as a table layer in the project</source>
+            <translation type="obsolete">Conserver les mesures comme couche table dans le projet</translation>
         </message>
         <message>
             <source>GeoTIFF with the images' bands and data type plus an alpha band, tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
