@@ -3,9 +3,10 @@
 All kernels are compiled with the decorators defined here, so caching, GIL
 release and floating-point flags are decided in one place:
 
-* ``cache=True`` with the cache in ``$TRUORTHO_CACHE_DIR/numba`` (default
-  ``~/.cache/truortho/numba``), because the plugin folder may be read-only in
-  a desktop install. An explicit ``NUMBA_CACHE_DIR`` wins.
+* ``cache=True`` with the cache in ``numba/`` of the per-user cache folder
+  (:mod:`truortho.core.cache`: ``$TRUORTHO_CACHE_DIR``, else the OS cache
+  folder), because the plugin folder may be read-only in a desktop install.
+  An explicit ``NUMBA_CACHE_DIR`` wins.
 * ``nogil=True`` so tiles can run in threads.
 * ``fastmath`` only for :data:`fastjit` kernels whose results are compared
   statistically (matching costs); geometry kernels stay IEEE-exact so that
@@ -22,10 +23,11 @@ from __future__ import annotations
 
 import os
 
+from .cache import cache_dir
+
 
 def _cache_dir() -> str:
-    base = os.environ.get("TRUORTHO_CACHE_DIR") or os.path.join(os.path.expanduser("~"), ".cache", "truortho")
-    return os.path.join(base, "numba")
+    return str(cache_dir("numba"))
 
 
 if not os.environ.get("NUMBA_CACHE_DIR"):

@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from .cache import cache_root
 from .errors import InputError
 from .memory import peak_rss_mb
 from .progress import EtaProgress, Progress, Steps, as_progress, check
@@ -221,7 +222,7 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
             raise InputError("IMAGES: no image files given")
         run = orient_images(
             list(images), camera_file=cfg.camera_file, gcps=gcps or [], crs=crs,
-            config=cfg.orient or OrientConfig(), work_dir=folder / ".truortho-cache", progress=steps[0],
+            config=cfg.orient or OrientConfig(), work_dir=cache_root(), progress=steps[0],
         )  # fmt: skip
         orientation = run.orientation
         if orientation.crs is None:

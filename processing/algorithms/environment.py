@@ -19,6 +19,7 @@ from qgis.core import (
     QgsProcessingAlgorithm,
     QgsProcessingException,
     QgsProcessingOutputString,
+    QgsProcessingParameterBoolean,
     QgsProcessingParameterFileDestination,
 )
 
@@ -78,6 +79,7 @@ def _plugin_version() -> str:
 class EnvironmentAlgorithm(QgsProcessingAlgorithm):
     OUTPUT = "OUTPUT"
     VERSIONS = "VERSIONS"
+    CLEAR_CACHE = "CLEAR_CACHE"
 
     def name(self) -> str:
         return "environment"
@@ -95,7 +97,9 @@ class EnvironmentAlgorithm(QgsProcessingAlgorithm):
         return tr(
             "Reports the versions of QGIS, GDAL, rasterio, numpy, numba, OpenCV and pyproj "
             "that TruOrtho runs with, and writes them to a JSON file. Fails if rasterio is "
-            "linked to a different GDAL than QGIS."
+            "linked to a different GDAL than QGIS. Also reports TruOrtho's cache folder (compiled "
+            "kernels and image features; the environment variable TRUORTHO_CACHE_DIR moves it, "
+            "default the per-user cache folder of the system) and its size; CLEAR_CACHE empties it."
         )
 
     def createInstance(self) -> EnvironmentAlgorithm:  # noqa: N802 - QGIS API
@@ -107,10 +111,25 @@ class EnvironmentAlgorithm(QgsProcessingAlgorithm):
                 self.OUTPUT, tr("Versions (JSON)"), tr("JSON files (*.json)")
             )
         )
+        self.addParameter(
+            QgsProcessingParameterBoolean(
+                self.CLEAR_CACHE,
+                tr("Clear the cache (compiled kernels, image features)"),
+                False,
+                optional=True,
+            )
+        )
         self.addOutput(QgsProcessingOutputString(self.VERSIONS, tr("Versions as JSON text")))
 
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 - QGIS API
+        from ...core.cache import cache_root, cache_size, clear_cache
+
+        if self.parameterAsBool(parameters, self.CLEAR_CACHE, context):
+            freed = clear_cache()
+            feedback.pushInfo(tr("Cache cleared: {:.1f} MB freed").format(freed / 1e6))
         versions = collect_versions()
+        versions["cache_dir"] = str(cache_root())
+        versions["cache_mb"] = f"{cache_size() / 1e6:.1f}"
         for key, value in versions.items():
             feedback.pushInfo(f"{key}: {value if value is not None else tr('not available')}")
 
