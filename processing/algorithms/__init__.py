@@ -5,6 +5,7 @@ Add a new algorithm by importing its class here and appending it to the list.
 
 from __future__ import annotations
 
+from .detecttargets import DetectTargetsAlgorithm
 from .dsmfilter import DsmFilterAlgorithm
 from .environment import EnvironmentAlgorithm
 from .exportorientation import ExportOrientationAlgorithm
@@ -23,6 +24,7 @@ ALGORITHMS: list[type] = [
     ImportOrientationAlgorithm,
     ExportOrientationAlgorithm,
     ImportGcpsAlgorithm,
+    DetectTargetsAlgorithm,
     OrientImagesAlgorithm,
     OsgmAlgorithm,
     TrueOrthoAlgorithm,

@@ -81,6 +81,37 @@ HELP: dict[str, dict] = {
             "top-left pixel, as in gcp_list.txt).",
         },
     },
+    "detecttargets": {
+        "summary": (
+            "Finds ground targets in every photo of a folder and writes an observation table with a "
+            "score per measurement. ArUco markers are found anywhere; the GCP is the marker's centre "
+            "(intersection of the diagonals of its outer corners), refined by least-squares matching "
+            "of the ideal marker. Circular and checkerboard (X) targets are searched near the "
+            "positions an orientation predicts for the GCPs, then refined the same way. Measurements "
+            "with a low score are kept and flagged, never dropped."
+        ),
+        "parameters": {
+            "IMAGES": "Folder of the photos (jpg, png, tif, jp2, bmp).",
+            "TARGET": "ArUco markers, circular targets (a dark disc on a light ground or the "
+            "reverse) or checkerboard targets (two dark and two light quadrants).",
+            "DICTIONARY": "The ArUco dictionary the markers were printed from.",
+            "MARKER_IDS": "ArUco only: marker ID to GCP name, e.g. 0=GCP1,1=GCP2. With a GCP layer, "
+            "every name must be in it.",
+            "ORIENTATION": "Circular and checkerboard targets: the orientation (TruOrtho JSON) of the "
+            "photos, used to predict where each GCP appears.",
+            "GCPS": "Point layer of the GCPs ('name' field; PointZ or a 'z' field) whose positions are "
+            "predicted; for ArUco it only checks the names of MARKER_IDS.",
+            "SEARCH_RADIUS": "Circular and checkerboard targets are searched this many pixels around "
+            "their predicted positions.",
+            "MIN_SCORE": "Measurements scoring lower (normalised cross-correlation of the ideal target "
+            "with the photo, 0 to 1) are flagged 'low score'.",
+            "REFINE": "Refine every centre by least-squares matching of the ideal target (gives the "
+            "standard deviations).",
+            "OUTPUT": "Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the top-left "
+            "pixel), score, sigma_x, sigma_y (pixels, empty when the refinement failed) and flag "
+            "(ok, low score, refinement failed: reason).",
+        },
+    },
     "orientimages": {
         "summary": (
             "Orients a block of overlapping photos: SIFT features at a working resolution, pair selection "
