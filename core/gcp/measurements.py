@@ -427,6 +427,20 @@ class MeasurementSet:
         self._apply(f"delete {gcp} on {image}", [((gcp, image), old, None)])
         return True
 
+    def place_many(self, measurements: Iterable[Measurement], label: str = "place") -> int:
+        """Place (or move) several measurements as one undoable command; returns how many changed.
+
+        All are validated first: one invalid measurement raises :class:`InputError` and changes nothing.
+        """
+        new: dict[_Key, Measurement] = {}
+        for m in measurements:
+            v = self.validated(m)
+            new[(v.gcp, v.image)] = v
+        changes: list[_Change] = [(k, self._data.get(k), m) for k, m in new.items() if self._data.get(k) != m]
+        if changes:
+            self._apply(label, changes)
+        return len(changes)
+
     def replace_all(self, measurements: Iterable[Measurement], label: str = "load") -> None:
         """Replace every measurement by ``measurements`` as one undoable command.
 
@@ -622,3 +636,116 @@ class MeasurementSet:
 
 def _num(v: float | None) -> str:
     return "" if v is None else repr(float(v))
+
+
+# ---------------------------------------------------------------------- refinement
+
+
+@dataclass(frozen=True)
+class RefineReport:
+    """Outcome of :func:`refine_gcp`.
+
+    ``refined``: images whose measurement was set (source ``refined``); ``failed``: image ->
+    reason for the images left as they were; ``reason``: why nothing was refined ("" = success);
+    ``correlation``: image -> normalised cross-correlation at the solution.
+    """
+
+    gcp: str
+    master: str
+    refined: list[str]
+    failed: dict[str, str]
+    reason: str = ""
+    correlation: dict[str, float] | None = None
+
+    def __bool__(self) -> bool:
+        return not self.reason and bool(self.refined)
+
+
+def refine_gcp(
+    mset: MeasurementSet,
+    orientation: Orientation,
+    gcp: str,
+    master: str,
+    half_size: int = 10,
+    config=None,
+) -> RefineReport:
+    """Measure a GCP in its other images by multi-image least-squares matching from one measurement.
+
+    The patch around the measurement of ``gcp`` on ``master`` is matched into every other image
+    where the GCP is measured or predicted, by geometrically constrained matching
+    (:func:`truortho.core.gcp.lsm.mgcm`: one object point for all images, collinearity with
+    ``orientation``). The object point starts on the master ray at the GCP's height, so an
+    orientation whose datum is off (a first run without GCPs, GNSS) still starts every image
+    near the point. The new measurements (source ``refined``, sigmas from the adjustment) are
+    placed as one undoable command; the master's measurement is not changed.
+
+    Parameters
+    ----------
+    mset : MeasurementSet
+    orientation : Orientation
+        Must contain ``master`` and the other images (matched by file name).
+    gcp, master : str
+        GCP name and the image of the measurement to start from.
+    half_size : int
+        Template half size in pixels (the template is ``2 half_size + 1`` pixels square).
+    config : truortho.core.gcp.lsm.LsmConfig, optional
+
+    Returns
+    -------
+    RefineReport
+        Failure (no texture, no convergence, the point behind a camera) is a report with a
+        ``reason``, not an exception; nothing is changed then.
+
+    Raises
+    ------
+    InputError
+        No measurement on ``master``; ``master`` not in the orientation; no other image.
+    """
+    from ..geometry.camera import pixel_to_ray
+    from ..imagery import luminance, read_image
+    from .lsm import MgcmView, extract_template, mgcm
+
+    g = mset.gcp(gcp)
+    start = mset.get(gcp, master)
+    if start is None:
+        raise InputError(f"GCP {gcp!r} is not measured on {master!r}: measure it there first")
+    index = _orientation_image_names(orientation)
+    if master not in index:
+        raise InputError(f"image {master!r} is not in the orientation")
+    others = [name for name in mset.images_of(gcp) if name != master and name in index]
+    if not others:
+        raise InputError(f"GCP {gcp!r} is neither measured nor predicted in another oriented image")
+
+    def view(name: str) -> MgcmView:
+        im = orientation.images[index[name]]
+        grey = luminance(read_image(mset.photo(name).path)).astype(np.float64)
+        return MgcmView(grey, im.R, im.C, orientation.camera_of(im), name)
+
+    views = [view(master)] + [view(n) for n in others]
+    z = orientation.frame.to_local(_world_in(orientation, [g]))[0, 2]
+    origin, d = pixel_to_ray(np.array([[start.x, start.y]]), views[0].R, views[0].C, views[0].camera)
+    if not (np.all(np.isfinite(d)) and abs(d[0, 2]) > 1e-9 and (z - origin[2]) / d[0, 2] > 0):
+        return RefineReport(gcp, master, [], {}, "the master ray does not reach the GCP's height")
+    X0 = origin + (z - origin[2]) / d[0, 2] * d[0]
+    try:  # a template off the image or without contrast: a report, not an error
+        template = extract_template(views[0].image, start.x, start.y, half_size)
+        result = mgcm(template, views, X0, config, master=0)
+    except InputError as err:
+        return RefineReport(gcp, master, [], {}, str(err))
+    if not result.converged:
+        return RefineReport(gcp, master, [], {}, result.reason or "no convergence")
+    refined: list[Measurement] = []
+    failed: dict[str, str] = {}
+    corr: dict[str, float] = {}
+    for name, r in zip(others, result.views[1:], strict=True):
+        corr[name] = float(r.correlation)
+        if not r.converged:
+            failed[name] = r.reason or "no convergence"
+        elif not mset.photo(name).contains(r.x, r.y):
+            failed[name] = "outside the image"
+        else:
+            sx = r.sigma_x if math.isfinite(r.sigma_x) and r.sigma_x > 0 else None
+            sy = r.sigma_y if math.isfinite(r.sigma_y) and r.sigma_y > 0 else None
+            refined.append(Measurement(gcp, name, r.x, r.y, sx, sy, "refined"))
+    mset.place_many(refined, f"refine {gcp} from {master}")
+    return RefineReport(gcp, master, [m.image for m in refined], failed, "", corr)
