@@ -108,6 +108,10 @@ class OsgmConfig:
         0-based band to match on; default the luminance.
     max_levels : int
         Upper bound of the pyramid depth.
+    chunk_memory : int
+        Bytes the whole-grid arrays of one coarse-to-fine run may take: a larger block is
+        matched chunk after chunk (:func:`plan_chunks`), so the memory does not grow with the
+        block. 0: one run whatever the size.
     cache_bytes : int
         Budget of decoded images kept in memory (per process: in this one, or per Dask worker).
     executor : {"inprocess", "local", "scheduler"}
@@ -151,6 +155,7 @@ class OsgmConfig:
     refine_edges: bool = True
     band: int | None = None
     max_levels: int = 5
+    chunk_memory: int = 1 << 30
     cache_bytes: int = 1 << 30
     executor: str = "inprocess"
     scheduler_address: str | None = None
@@ -200,6 +205,12 @@ class OsgmConfig:
         if self.workers is not None and int(self.workers) < 1:
             raise InputError(f"workers: expected at least 1, got {self.workers!r}")
         parse_memory(self.worker_memory)
+        if (
+            isinstance(self.chunk_memory, bool)
+            or not isinstance(self.chunk_memory, int)
+            or self.chunk_memory < 0
+        ):
+            raise InputError(f"chunk_memory: expected a number of bytes >= 0, got {self.chunk_memory!r}")
 
     def tile_params(self) -> TileParams:
         return TileParams(
@@ -770,10 +781,24 @@ def run_osgm(
         )  # fmt: skip
 
 
-def _run_systems(
-    o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
-    z_surface, progress, t0,
-) -> OsgmResult:  # fmt: skip
+@dataclass
+class _Surface:
+    """What the reference systems matched over one grid (world heights; before any writing)."""
+
+    dsm: np.ndarray  # (rows, cols) float32 world heights, NaN where rejected
+    conf: np.ndarray  # (rows, cols) float32 in [0, 1], NaN where rejected
+    rgb: np.ndarray | None  # (rows, cols, 3) uint8, 0 = no colour
+    clouds: list  # (world xyz, rgb, confidence) of every oblique system
+    systems: list
+    levels: int
+    tiles: int
+    max_volume: int
+
+
+def _match_surface(
+    o, cfg, grid, local, pyr, executor, cache, cache_base, zmin, zmax, dz, z_surface, progress, want_rgb
+) -> _Surface:
+    """Every reference system over ``grid`` (world) / ``local`` (the same cells in the local frame)."""
     off = o.offset
     systems = reference_systems(o, cfg.oblique, cfg.oblique_group_angle)
     weights = [1.0] + [0.5] * (len(systems) - 1)
@@ -785,7 +810,6 @@ def _run_systems(
     zsw = None
     if z_surface is not None:
         zsw = _surface_windows(z_surface, grid, plan, cfg, off[2])
-        zsrc = "Z_SURFACE"
     nadir = _match_system(
         o,
         systems[0],
@@ -807,38 +831,70 @@ def _run_systems(
 
     # --- oblique systems
     clouds = []
-    sys_stats = [
-        {
-            "id": 0,
-            "name": "nadir",
-            "view_direction": [0.0, 0.0, -1.0],
-            "images": len(o.images),
-            "points": int(np.isfinite(dsm).sum()),
-        }
-    ]
     pos = 0.8 * weights[0] / wsum
     for s, w in zip(systems[1:], weights[1:], strict=True):
         sub = SubProgress(progress, pos, pos + 0.8 * w / wsum)
         pos += 0.8 * w / wsum
-        cloud = _oblique_points(
-            o, s, pyr, local, zmin, zmax, dz, cfg, sub, outputs.point_cloud is not None,
-            executor, cache, cache_base,
-        )  # fmt: skip
-        clouds.append(cloud)
-        sys_stats.append(
+        clouds.append(
+            _oblique_points(
+                o,
+                s,
+                pyr,
+                local,
+                zmin,
+                zmax,
+                dz,
+                cfg,
+                sub,
+                want_rgb,
+                executor,
+                cache,
+                cache_base,
+            )  # fmt: skip
+        )
+    return _Surface(dsm, conf, nadir.rgb, clouds, systems, len(plan.levels), nadir.tiles, nadir.max_volume)
+
+
+def _system_stats(systems, nadir_points: int, oblique_points: list[int], n_images: int) -> list[dict]:
+    out = [{"id": 0, "name": "nadir", "view_direction": [0.0, 0.0, -1.0], "images": n_images,
+            "points": int(nadir_points)}]  # fmt: skip
+    for s, n in zip(systems[1:], oblique_points, strict=True):
+        out.append(
             {
                 "id": s.id,
                 "name": s.name,
                 "view_direction": [float(v) for v in s.direction],
                 "images": len(s.images),
-                "points": int(len(cloud[0])),
+                "points": int(n),
             }
         )
+    return out
 
+
+def _run_systems(
+    o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
+    z_surface, progress, t0,
+) -> OsgmResult:  # fmt: skip
+    off = o.offset
+    if z_surface is not None:
+        zsrc = "Z_SURFACE"
+    chunks = plan_chunks(grid, cfg, plan_levels(zmin, zmax, dz, local, cfg.max_levels).levels[0])
+    if len(chunks) > 1:
+        return _run_chunked(
+            o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
+            z_surface, progress, t0, chunks,
+        )  # fmt: skip
+    surf = _match_surface(
+        o, cfg, grid, local, pyr, executor, cache, cache_base, zmin, zmax, dz, z_surface, progress,
+        outputs.point_cloud is not None,
+    )  # fmt: skip
+    dsm, conf = surf.dsm, surf.conf
+    sys_stats = _system_stats(surf.systems, int(np.isfinite(dsm).sum()), [len(c[0]) for c in surf.clouds],
+                              len(o.images))  # fmt: skip
     if progress.cancelled():
         raise CancelledError("OSGM cancelled")
     progress.update(0.85, "writing outputs")
-    written = _write_outputs(o, grid, dsm, conf, nadir.rgb, clouds, systems, outputs, res)
+    written = _write_outputs(o, grid, dsm, conf, surf.rgb, surf.clouds, surf.systems, outputs, res)
     ok = np.isfinite(dsm)
     stats = {
         "rows": grid.rows,
@@ -849,8 +905,9 @@ def _run_systems(
         "z_max": zmax + off[2],
         "z_source": zsrc,
         "z_mid": zs_mid + off[2],
-        "levels": len(plan.levels),
-        "tiles": nadir.tiles,
+        "levels": surf.levels,
+        "tiles": surf.tiles,
+        "chunks": 1,
         "extent": list(grid.extent),
         "completeness": float(ok.mean()),
         "mean_confidence": float(np.nanmean(conf)) if ok.any() else 0.0,
@@ -860,7 +917,159 @@ def _run_systems(
         "executor": executor.describe() if hasattr(executor, "describe") else type(executor).__name__,
         "cache_hits": cache.hits,
         "cache_tiles_written": cache.written,
-        "task_volume_bytes": 4 * nadir.max_volume,
+        "task_volume_bytes": 4 * surf.max_volume,
+        "seconds": time.perf_counter() - t0,
+    }
+    progress.update(1.0, "OSGM done")
+    return OsgmResult(grid, stats, written)
+
+
+#: Bytes per finest-level cell that a chunk holds at once: the levels' heights and confidences
+#: (float32, the coarser levels add a third), the filled guide, the world DSM and confidence,
+#: the colours, and the chunk's share of the point cloud (xyz float64, colour, confidence, id).
+CHUNK_BYTES_PER_CELL = 96
+
+
+def plan_chunks(grid: RasterGrid, cfg: OsgmConfig, top_level: int):
+    """The chunks of ``grid`` that OSGM matches one after the other (a list of :class:`~..grid.Tile`).
+
+    A chunk's arrays are whole-grid arrays of its own coarse-to-fine run, so a block too
+    large for ``cfg.chunk_memory`` bytes (:data:`CHUNK_BYTES_PER_CELL` per cell) is cut
+    into square chunks that fit. Every chunk is matched on its core plus a margin as wide
+    as the tiles' overlap on the coarsest level ``top_level`` (``max(16, tile_size / 8)``
+    cells there, i.e. ``2^top_level`` times that on the finest level), so a chunk's border
+    is no worse than a tile's border on every level; core and margin are multiples of
+    ``2^top_level`` cells, so the chunks' coarse levels fall on the cells of the whole grid's.
+    A grid that fits is one chunk.
+    """
+    budget = int(cfg.chunk_memory)
+    if budget <= 0 or grid.rows * grid.cols * CHUNK_BYTES_PER_CELL <= budget:
+        return grid.tiles(max(grid.rows, grid.cols), 0)
+    unit = 2 ** max(int(top_level), 0)
+    margin = max(16, int(cfg.tile_size) // 8) * unit
+    side = int(math.isqrt(budget // CHUNK_BYTES_PER_CELL)) - 2 * margin
+    side = max(2 * margin, side // unit * unit)
+    return grid.tiles(side, margin)
+
+
+def _run_chunked(
+    o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
+    z_surface, progress, t0, chunks,
+) -> OsgmResult:  # fmt: skip
+    """OSGM chunk by chunk (:func:`plan_chunks`): only the cores are written, window by window."""
+    from contextlib import ExitStack
+
+    from ..progress import SubProgress
+    from ..rasterio_io import RasterWriter
+    from ..surface.pointcloud import PointCloud, PointCloudFile, ReferenceSystem, merge_point_clouds
+
+    off = o.offset
+    systems = reference_systems(o, cfg.oblique, cfg.oblique_group_angle)
+    refs = [
+        ReferenceSystem(s.id, s.name, (float(s.direction[0]), float(s.direction[1]), float(s.direction[2])))
+        for s in systems
+    ]
+    valid = tiles = levels = max_volume = 0
+    conf_sum = 0.0
+    points = [0] * len(systems)
+    written: dict = {}
+    with ExitStack() as stack:
+        w_dsm = stack.enter_context(
+            RasterWriter(outputs.dsm, grid, 1, "float32", DSM_NODATA, ["height"], overviews=True)
+        )
+        w_conf = w_rgb = cloud_file = None
+        if outputs.confidence is not None:
+            w_conf = stack.enter_context(
+                RasterWriter(outputs.confidence, grid, 1, "float32", -1.0, ["confidence"])
+            )
+        if outputs.orthoimage is not None:
+            w_rgb = stack.enter_context(RasterWriter(outputs.orthoimage, grid, 3, "uint8", 0, overviews=True))
+        if outputs.point_cloud is not None:
+            cloud_file = stack.enter_context(PointCloudFile(outputs.point_cloud, o.crs, refs))
+        for k, ch in enumerate(chunks):
+            if progress.cancelled():
+                raise CancelledError("OSGM cancelled")
+            sub = SubProgress(progress, 0.95 * k / len(chunks), 0.95 * (k + 1) / len(chunks))
+            surf = _match_surface(
+                o, cfg, ch.outer_grid(grid), ch.outer_grid(local), pyr, executor, cache, cache_base,
+                zmin, zmax, dz, z_surface, sub, outputs.point_cloud is not None,
+            )  # fmt: skip
+            ins = ch.inner_slices
+            dsm, conf = surf.dsm[ins], surf.conf[ins]
+            rgb = surf.rgb[ins] if surf.rgb is not None else np.zeros(dsm.shape + (3,), np.uint8)
+            ok = np.isfinite(dsm)
+            valid += int(ok.sum())
+            conf_sum += float(conf[ok].sum())
+            tiles += surf.tiles
+            levels = max(levels, surf.levels)
+            max_volume = max(max_volume, surf.max_volume)
+            w_dsm.write(np.where(ok, dsm, DSM_NODATA).astype(np.float32), ch.core)
+            if w_conf is not None:
+                w_conf.write(np.where(ok, conf, -1.0).astype(np.float32), ch.core)
+            if w_rgb is not None:
+                w_rgb.write(np.moveaxis(rgb, -1, 0), ch.core)
+            # the oblique points whose plan position lies in this chunk's core (each point once)
+            cx0, cy0, cx1, cy1 = ch.core_grid(grid).extent
+            parts = []
+            core = ch.core_grid(grid)
+            X, Y = core.centres()
+            parts.append(
+                PointCloud(
+                    np.column_stack([X[ok], Y[ok], dsm[ok].astype(np.float64)]),
+                    rgb[ok],
+                    conf[ok],
+                    np.zeros(int(ok.sum()), np.uint16),
+                    o.crs,
+                    [refs[0]],
+                )  # fmt: skip
+            )
+            points[0] += int(ok.sum())
+            for j, (xyz, prgb, pconf) in enumerate(surf.clouds, start=1):
+                inside = (xyz[:, 0] >= cx0) & (xyz[:, 0] < cx1) & (xyz[:, 1] > cy0) & (xyz[:, 1] <= cy1)
+                points[j] += int(inside.sum())
+                if inside.any():
+                    parts.append(
+                        PointCloud(
+                            xyz[inside],
+                            prgb[inside] if prgb is not None else None,
+                            pconf[inside],
+                            np.full(int(inside.sum()), refs[j].id, np.uint16),
+                            o.crs,
+                            [refs[j]],
+                        )  # fmt: skip
+                    )
+            if cloud_file is not None:
+                merged = merge_point_clouds(parts, voxel=None) if len(parts) > 1 else parts[0]
+                cloud_file.add(merged)
+            del surf, parts
+        progress.update(0.96, "writing outputs")
+    written["dsm"] = str(outputs.dsm)
+    for name in ("confidence", "orthoimage", "point_cloud"):
+        if getattr(outputs, name) is not None:
+            written[name] = str(getattr(outputs, name))
+    cells = grid.rows * grid.cols
+    stats = {
+        "rows": grid.rows,
+        "cols": grid.cols,
+        "resolution": res,
+        "z_step": dz,
+        "z_min": zmin + off[2],
+        "z_max": zmax + off[2],
+        "z_source": zsrc,
+        "z_mid": zs_mid + off[2],
+        "levels": levels,
+        "tiles": tiles,
+        "chunks": len(chunks),
+        "extent": list(grid.extent),
+        "completeness": valid / max(cells, 1),
+        "mean_confidence": conf_sum / valid if valid else 0.0,
+        "systems": _system_stats(systems, points[0], points[1:], len(o.images)),
+        "images": len(o.images),
+        "image_reads": pyr.reads,
+        "executor": executor.describe() if hasattr(executor, "describe") else type(executor).__name__,
+        "cache_hits": cache.hits,
+        "cache_tiles_written": cache.written,
+        "task_volume_bytes": 4 * max_volume,
         "seconds": time.perf_counter() - t0,
     }
     progress.update(1.0, "OSGM done")

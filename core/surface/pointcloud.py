@@ -276,6 +276,68 @@ def write_point_cloud_file(
     return {"points": len(cloud), "path": str(path), "ept": None if ept is None else str(ept)}
 
 
+class PointCloudFile:
+    """One LAS/LAZ file written from several :class:`PointCloud` chunks (bounded memory).
+
+    Every chunk must have what the file was opened for: colours when ``rgb``, confidence
+    and system ids when ``confidence`` / ``system``. Use as a context manager; the file is
+    renamed into place when the block ends without an error (:class:`PointCloudWriter`)::
+
+        with PointCloudFile(path, crs, systems) as f:
+            for cloud in chunks:
+                f.add(cloud)
+    """
+
+    def __init__(
+        self,
+        path,
+        crs: str | None,
+        systems: list[ReferenceSystem],
+        rgb: bool = True,
+        confidence: bool = True,
+        system: bool = True,
+        scale: float = 0.001,
+    ) -> None:
+        from ..rasterio_io import PointCloudWriter
+
+        dims = {}
+        if confidence:
+            dims[CONFIDENCE] = np.dtype(np.float32)
+        if system:
+            dims[SYSTEM] = np.dtype(np.uint16)
+        self._dims = dims
+        self._rgb = bool(rgb)
+        self._writer = PointCloudWriter(path, crs, self._rgb, dims, scale=scale, vlrs=_systems_vlr(systems))
+
+    @property
+    def count(self) -> int:
+        return int(self._writer.count)
+
+    def __enter__(self) -> PointCloudFile:
+        self._writer.__enter__()
+        return self
+
+    def add(self, cloud: PointCloud) -> None:
+        if len(cloud) == 0:
+            return
+        extra, _ = _extra(cloud)
+        if set(extra) != set(self._dims) or (cloud.rgb is not None) != self._rgb:
+            raise InputError(
+                f"{self._writer.path}: a chunk with {sorted(extra)} and rgb={cloud.rgb is not None}, "
+                f"but the file holds {sorted(self._dims)} and rgb={self._rgb}"
+            )
+        for a in range(0, len(cloud), 1_000_000):
+            b = min(a + 1_000_000, len(cloud))
+            self._writer.write(
+                cloud.xyz[a:b],
+                None if cloud.rgb is None else cloud.rgb[a:b],
+                **{k: v[a:b] for k, v in extra.items()},
+            )
+
+    def __exit__(self, exc_type, exc, tb) -> None:
+        self._writer.__exit__(exc_type, exc, tb)
+
+
 def _extra(cloud: PointCloud) -> tuple[dict[str, np.ndarray], dict[str, np.dtype]]:
     extra: dict[str, np.ndarray] = {}
     if cloud.confidence is not None:

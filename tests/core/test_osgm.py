@@ -420,3 +420,51 @@ def test_edge_refinement_undoes_fattening(tmp_path):
     print(f"\nfattened / eroded share near walls: without {shares[False]}, with refinement {shares[True]}")
     assert shares[True][0] < 0.8 * shares[False][0]
     assert shares[True][1] < shares[False][1] + 0.05
+
+
+@pytest.mark.slow
+def test_chunked_run_matches_one_run(tmp_path):
+    """A block larger than ``chunk_memory`` is matched chunk by chunk and written by windows: the same
+    DSM as one run (SGM paths and coarse levels see the same surroundings within the margins), the
+    point cloud holds every valid cell once, and no chunk is written twice or left out."""
+    from truortho.core.osgm.pipeline import CHUNK_BYTES_PER_CELL
+    from truortho.core.surface.pointcloud import read_point_cloud
+
+    cfg = SceneConfig(image_size=(320, 240), focal_px=400.0, seed=3, n_oblique=0)
+    scene = make_scene(cfg)
+    scene.write(tmp_path)
+    res = 3 * cfg.gsd
+    runs, stats = {}, {}
+    # a budget below the smallest chunk: cores of twice the margin (16 cells of tile overlap x 2^2 on the
+    # coarsest level = 64 cells), 128 cells, i.e. 2 x 2 chunks of the 160 x 134 cells
+    for name, mem in (("one", 0), ("chunks", 100**2 * CHUNK_BYTES_PER_CELL)):
+        out = OsgmOutputs(
+            dsm=tmp_path / f"{name}.tif", confidence=tmp_path / f"{name}_c.tif",
+            orthoimage=tmp_path / f"{name}_o.tif", point_cloud=tmp_path / f"{name}.laz",
+        )  # fmt: skip
+        r = run_osgm(scene.orientation, OsgmConfig(resolution=res, tile_size=64, chunk_memory=mem),
+                     scene.extent_world(), out, tmp_path)  # fmt: skip
+        runs[name] = read_raster(out.dsm)[0]
+        stats[name] = r.stats
+    grid = read_raster(tmp_path / "one.tif")[1]
+    assert read_raster(tmp_path / "chunks.tif")[1].shape == grid.shape
+    truth, nvis = _truth_and_seen(scene, grid)
+    seen = nvis >= 2
+    good = {k: (np.abs(np.nan_to_num(d - truth, nan=1e9)) <= 3 * res)[seen].mean() for k, d in runs.items()}
+    agree = (np.abs(np.nan_to_num(runs["one"] - runs["chunks"], nan=1e9)) <= res)[seen].mean()
+    print(f"\nchunks {stats['chunks']['chunks']} (levels {stats['one']['levels']}): within 3 x res one run "
+          f"{good['one']:.4f}, chunked {good['chunks']:.4f}; agreement within 1 res {agree:.4f}")  # fmt: skip
+    assert stats["one"]["chunks"] == 1 and stats["chunks"]["chunks"] >= 4
+    with pytest.raises(InputError, match="chunk_memory"):
+        OsgmConfig(chunk_memory=-1).validate()
+    assert good["chunks"] > 0.9 and abs(good["one"] - good["chunks"]) < 0.01
+    assert agree > 0.97
+    assert stats["chunks"]["completeness"] == pytest.approx(np.isfinite(runs["chunks"]).mean())
+    pc = read_point_cloud(tmp_path / "chunks.laz")
+    assert len(pc) == int(np.isfinite(runs["chunks"]).sum()) and pc.rgb is not None
+    # every valid cell once: the points fall on distinct cell centres
+    r_, c_ = grid.cell_of(pc.xyz[:, 0], pc.xyz[:, 1])
+    cells = np.round(r_).astype(np.int64) * grid.cols + np.round(c_).astype(np.int64)
+    assert len(np.unique(cells)) == len(pc)
+    ortho = read_raster(tmp_path / "chunks_o.tif", band=None)[0]
+    assert ((ortho.sum(axis=0) > 0) == np.isfinite(runs["chunks"])).mean() > 0.99
