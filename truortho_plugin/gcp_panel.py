@@ -169,7 +169,13 @@ class GcpPanel(QDockWidget):
             tr("Delete the measurement of the current GCP in this image (Del)"),
             self.delete_current,
         )
-        for b in (self.undo_button, self.redo_button, self.delete_button):
+        self.refine_button = self._button(
+            tr("Refine"),
+            tr("Measure the current GCP in its other images by least-squares matching from this image's "
+               "measurement (needs an orientation)"),
+            self.refine_current,
+        )  # fmt: skip
+        for b in (self.refine_button, self.undo_button, self.redo_button, self.delete_button):
             row.addWidget(b)
         lay.addLayout(row)
 
@@ -460,6 +466,32 @@ class GcpPanel(QDockWidget):
             self._changed()
         return done
 
+    def refine_current(self) -> bool:
+        """Refine: the current GCP in its other images by MGCM from the measurement on the current image."""
+        from ..core.gcp.measurements import refine_gcp
+
+        m = self.model
+        if m is None or self.current_gcp is None or self.current_image is None:
+            self.show_message(tr("Load the images and the GCPs first."))
+            return False
+        if self.orientation is None:
+            self.show_message(tr("Refining needs an orientation: choose one and load again."))
+            return False
+        try:
+            report = refine_gcp(m, self.orientation, self.current_gcp, self.current_image)
+        except (TruOrthoError, OSError) as err:
+            self.show_message(str(err))
+            return False
+        if not report:
+            self.show_message(tr("Refinement failed: {}").format(report.reason or tr("no image matched")))
+            return False
+        self._changed()
+        text = tr("{} refined in {} images").format(self.current_gcp, len(report.refined))
+        if report.failed:
+            text += tr("; not in {}").format(", ".join(f"{k} ({v})" for k, v in report.failed.items()))
+        self.show_message(text, Qgis.Success if not report.failed else Qgis.Warning)
+        return True
+
     def undo(self) -> bool:
         if self.model is None or not self.model.undo():
             return False
@@ -509,6 +541,7 @@ class GcpPanel(QDockWidget):
 
     def _update_buttons(self) -> None:
         m = self.model
+        self.refine_button.setEnabled(bool(m and self.orientation is not None))
         self.undo_button.setEnabled(bool(m and m.can_undo))
         self.redo_button.setEnabled(bool(m and m.can_redo))
         self.undo_button.setToolTip(tr("Undo (Ctrl+Z)") + (f": {m.undo_label()}" if m and m.can_undo else ""))

@@ -276,3 +276,66 @@ def test_plugin_action_shows_the_dock(qgis_iface, truortho_plugin):
         truortho_plugin.unload_gui()
         truortho_plugin.iface = None
     assert truortho_plugin.gcp_panel is None and truortho_plugin.gcp_action is None
+
+
+def test_refine_button_measures_the_other_images(tmp_path, qgis_processing_ready):
+    """Refine (MGCM of core/gcp/lsm) from one measurement on four rendered photos of a textured plane:
+    the other three images get 'refined' measurements within 0.15 px of the truth; one undo removes them."""
+    import cv2
+    from qgis.core import QgsFeature, QgsGeometry, QgsPoint, QgsProject, QgsVectorLayer
+    from qgis.PyQt.QtCore import Qt
+    from qgis.PyQt.QtTest import QTest
+
+    from truortho.core.geometry.camera import project_points
+    from truortho.core.geometry.frame import LocalFrame
+    from truortho.core.orientation import Image, Orientation
+    from truortho.core.synthetic import make_camera
+    from truortho.core.synthetic.cameras import look_at_rotation, nadir_rotation
+    from truortho.core.synthetic.targets import render_on_plane
+    from truortho.truortho_plugin.gcp_panel import GcpPanel
+
+    rng = np.random.default_rng(8)
+    cam = make_camera(320, 240, 400.0, distortion=(-0.05, 0.01, 0, 0, 0))
+    tex = cv2.GaussianBlur(rng.uniform(0, 1, (400, 400)), (0, 0), 10.0)
+    tex = (tex - tex.min()) / (tex.max() - tex.min())
+    Xt = np.array([0.5, 0.8, 0.0])
+    folder = tmp_path / "photos"
+    folder.mkdir()
+    images = []
+    for i, C in enumerate([[0, 0, 30], [7, 3, 29], [-5, 6, 31], [2, -8, 30]]):
+        C = np.array(C, float)
+        R = nadir_rotation(-30.0) if i == 0 else look_at_rotation(C, Xt)
+        img = render_on_plane(tex, 0.01, (0.0, 0.0), 0.0, R, C, cam) * 220 + 15
+        cv2.imwrite(str(folder / f"p{i}.png"), np.clip(np.round(img), 0, 255).astype(np.uint8))
+        images.append(Image(f"p{i}.png", cam.id, R, C))
+    o = Orientation(LocalFrame(CRS, OFFSET), {cam.id: cam}, images, image_root=str(folder))
+    o.save(tmp_path / "orientation.json")
+    truth = {im.name: project_points(Xt[None], im.R, im.C, cam)[0] for im in images}
+    layer = QgsVectorLayer(f"PointZ?crs={CRS}&field=name:string", "gcps", "memory")
+    f = QgsFeature(layer.fields())
+    f.setAttributes(["T"])
+    f.setGeometry(QgsGeometry(QgsPoint(*(Xt + OFFSET + [0.2, 0.1, 0.5]))))  # surveyed a little off
+    layer.dataProvider().addFeatures([f])
+    QgsProject.instance().addMapLayer(layer)
+    panel = GcpPanel()
+    try:
+        panel.folder_edit.setText(str(folder))
+        panel.layer_combo.setLayer(layer)
+        panel.orientation_edit.setText(str(tmp_path / "orientation.json"))
+        assert panel.load(), panel.last_message
+        assert panel.model.images_of("T") == ["p0.png", "p1.png", "p2.png", "p3.png"]
+        panel.select("T", "p0.png")
+        assert panel.place_at(*truth["p0.png"])
+        assert panel.refine_button.isEnabled()
+        QTest.mouseClick(panel.refine_button, Qt.LeftButton)
+        assert panel.last_message[0] == "success", panel.last_message
+        for name in ("p1.png", "p2.png", "p3.png"):
+            got = panel.model.get("T", name)
+            assert got.source == "refined"
+            assert np.hypot(got.x - truth[name][0], got.y - truth[name][1]) < 0.15
+            r, c = panel.cell_of("T", name)
+            assert panel.table.item(r, c).text() == "●"
+        assert panel.undo() and len(panel.model) == 1
+    finally:
+        panel.deleteLater()
+        QgsProject.instance().removeAllMapLayers()
