@@ -1949,7 +1949,7 @@
             <translation>von keinem Bild gesehen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="206" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
             <source>Load measurements from a CSV table or gcp_list.txt</source>
             <translation>Messungen aus einer CSV-Tabelle oder gcp_list.txt laden</translation>
         </message>
@@ -2019,52 +2019,62 @@
             <translation>Messung des aktuellen GCP in diesem Bild löschen (Entf)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="197" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="173" />
+            <source>Refine</source>
+            <translation>Verfeinern</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="174" />
+            <source>Measure the current GCP in its other images by least-squares matching from this image's measurement (needs an orientation)</source>
+            <translation>Den aktuellen GCP in seinen anderen Bildern per Kleinste-Quadrate-Zuordnung ausgehend von der Messung in diesem Bild messen (benötigt eine Orientierung)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="203" />
             <source>Click: place the current GCP; drag: pan; wheel: zoom</source>
             <translation>Klick: aktuellen GCP setzen; Ziehen: verschieben; Mausrad: zoomen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="251" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="257" />
             <source>Orientations (*.json *.txt);;All files (*)</source>
             <translation>Orientierungen (*.json *.txt);;Alle Dateien (*)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="354" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="360" />
             <source>predicted</source>
             <translation>vorhergesagt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="354" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="360" />
             <source>not measured</source>
             <translation>nicht gemessen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="555" />
             <source>Save the observation table</source>
             <translation>Beobachtungstabelle speichern</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="555" />
             <source>CSV (*.csv)</source>
             <translation>CSV (*.csv)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="528" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="561" />
             <source>Save gcp_list.txt</source>
             <translation>gcp_list.txt speichern</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="529" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="562" />
             <source>gcp_list (*.txt)</source>
             <translation>gcp_list (*.txt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="534" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="567" />
             <source>Open measurements</source>
             <translation>Messungen öffnen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="535" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="568" />
             <source>Observation tables (*.csv *.txt)</source>
             <translation>Beobachtungstabellen (*.csv *.txt)</translation>
         </message>
@@ -2079,137 +2089,162 @@
             <translation>Orientierungsdatei wählen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="194" />
             <source>Previous image (Page Up)</source>
             <translation>Vorheriges Bild (Bild auf)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="189" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="195" />
             <source>Next image (Page Down)</source>
             <translation>Nächstes Bild (Bild ab)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="190" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="196" />
             <source>Previous GCP (Ctrl+Page Up)</source>
             <translation>Vorheriger GCP (Strg+Bild auf)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="191" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="197" />
             <source>Next GCP (Ctrl+Page Down)</source>
             <translation>Nächster GCP (Strg+Bild ab)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="192" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="198" />
             <source>Fit</source>
             <translation>Einpassen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="192" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="198" />
             <source>Show the whole image (F)</source>
             <translation>Ganzes Bild zeigen (F)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="207" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="213" />
             <source>Open table…</source>
             <translation>Tabelle öffnen…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="209" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="215" />
             <source>Save table…</source>
             <translation>Tabelle speichern…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="209" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="215" />
             <source>Save the observation table (CSV)</source>
             <translation>Beobachtungstabelle speichern (CSV)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="218" />
             <source>Save gcp_list…</source>
             <translation>gcp_list speichern…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="218" />
             <source>Save as ODM gcp_list.txt</source>
             <translation>Als ODM-gcp_list.txt speichern</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="215" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="221" />
             <source>Add table layer</source>
             <translation>Tabellenlayer hinzufügen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="216" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="222" />
             <source>Keep the measurements as a table layer in the project: the saved CSV table, rewritten as you measure (a temporary layer until a table is saved)</source>
             <translation>Messungen als Tabellenlayer im Projekt behalten: die gespeicherte CSV-Tabelle, beim Messen laufend neu geschrieben (bis eine Tabelle gespeichert ist, ein temporärer Layer)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="274" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="280" />
             <source>Choose the folder of the photos first.</source>
             <translation>Zuerst den Ordner der Fotos wählen.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="277" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="283" />
             <source>Choose a GCP point layer first (fields: name, optional role and z).</source>
             <translation>Zuerst einen GCP-Punktlayer wählen (Felder: name, optional role und z).</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="301" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="307" />
             <source>{} GCPs, {} images</source>
             <translation>{} GCPs, {} Bilder</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="444" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="450" />
             <source>Load the images and the GCPs first.</source>
             <translation>Zuerst die Bilder und die GCPs laden.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="602" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="478" />
+            <source>Refining needs an orientation: choose one and load again.</source>
+            <translation>Verfeinern benötigt eine Orientierung: eine wählen und erneut laden.</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="489" />
+            <source>{} refined in {} images</source>
+            <translation>{} in {} Bildern verfeinert</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="635" />
             <source>GCP observations</source>
             <translation>GCP-Beobachtungen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="303" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="309" />
             <source>; {} predicted positions</source>
             <translation>; {} vorhergesagte Positionen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="505" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="491" />
+            <source>; not in {}</source>
+            <translation>; nicht in {}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="537" />
             <source>{} on {}: {} — {} measured, {} to do — zoom {:.2f}</source>
             <translation>{} in {}: {} — {} gemessen, {} offen — Zoom {:.2f}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="324" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="330" />
             <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</source>
             <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="325" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="331" />
             <source> (check point)</source>
             <translation> (Kontrollpunkt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="558" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="486" />
+            <source>Refinement failed: {}</source>
+            <translation>Verfeinerung fehlgeschlagen: {}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="486" />
+            <source>no image matched</source>
+            <translation>kein Bild zugeordnet</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="591" />
             <source>Saved {} measurements to {}</source>
             <translation>{} Messungen in {} gespeichert</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="583" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="616" />
             <source>Loaded {} measurements from {}</source>
             <translation>{} Messungen aus {} geladen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="283" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="289" />
             <source>GCP layer {!r} has no point</source>
             <translation>GCP-Layer {!r} enthält keinen Punkt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="386" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="392" />
             <source>Cannot read the image {}</source>
             <translation>Das Bild {} kann nicht gelesen werden</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="604" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="637" />
             <source>Cannot open {} as a table layer</source>
             <translation>{} kann nicht als Tabellenlayer geöffnet werden</translation>
         </message>

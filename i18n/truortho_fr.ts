@@ -1949,7 +1949,7 @@
             <translation>vu par aucune image</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="206" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
             <source>Load measurements from a CSV table or gcp_list.txt</source>
             <translation>Charger les mesures depuis une table CSV ou un gcp_list.txt</translation>
         </message>
@@ -2019,52 +2019,62 @@
             <translation>Supprimer la mesure du point d'appui courant dans cette image (Suppr)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="197" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="173" />
+            <source>Refine</source>
+            <translation>Affiner</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="174" />
+            <source>Measure the current GCP in its other images by least-squares matching from this image's measurement (needs an orientation)</source>
+            <translation>Mesurer le point d'appui courant dans ses autres images par corrélation par moindres carrés à partir de la mesure de cette image (nécessite une orientation)</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="203" />
             <source>Click: place the current GCP; drag: pan; wheel: zoom</source>
             <translation>Clic : placer le point d'appui courant ; glisser : déplacer la vue ; molette : zoomer</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="251" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="257" />
             <source>Orientations (*.json *.txt);;All files (*)</source>
             <translation>Orientations (*.json *.txt);;Tous les fichiers (*)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="354" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="360" />
             <source>predicted</source>
             <translation>prédit</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="354" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="360" />
             <source>not measured</source>
             <translation>non mesuré</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="555" />
             <source>Save the observation table</source>
             <translation>Enregistrer la table des observations</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="522" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="555" />
             <source>CSV (*.csv)</source>
             <translation>CSV (*.csv)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="528" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="561" />
             <source>Save gcp_list.txt</source>
             <translation>Enregistrer gcp_list.txt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="529" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="562" />
             <source>gcp_list (*.txt)</source>
             <translation>gcp_list (*.txt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="534" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="567" />
             <source>Open measurements</source>
             <translation>Ouvrir des mesures</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="535" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="568" />
             <source>Observation tables (*.csv *.txt)</source>
             <translation>Tables d'observations (*.csv *.txt)</translation>
         </message>
@@ -2079,137 +2089,162 @@
             <translation>Choisir un fichier d'orientation</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="188" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="194" />
             <source>Previous image (Page Up)</source>
             <translation>Image précédente (Page préc.)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="189" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="195" />
             <source>Next image (Page Down)</source>
             <translation>Image suivante (Page suiv.)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="190" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="196" />
             <source>Previous GCP (Ctrl+Page Up)</source>
             <translation>Point d'appui précédent (Ctrl+Page préc.)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="191" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="197" />
             <source>Next GCP (Ctrl+Page Down)</source>
             <translation>Point d'appui suivant (Ctrl+Page suiv.)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="192" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="198" />
             <source>Fit</source>
             <translation>Ajuster</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="192" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="198" />
             <source>Show the whole image (F)</source>
             <translation>Afficher l'image entière (F)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="207" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="213" />
             <source>Open table…</source>
             <translation>Ouvrir une table…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="209" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="215" />
             <source>Save table…</source>
             <translation>Enregistrer la table…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="209" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="215" />
             <source>Save the observation table (CSV)</source>
             <translation>Enregistrer la table des observations (CSV)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="218" />
             <source>Save gcp_list…</source>
             <translation>Enregistrer gcp_list…</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="212" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="218" />
             <source>Save as ODM gcp_list.txt</source>
             <translation>Enregistrer au format ODM gcp_list.txt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="215" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="221" />
             <source>Add table layer</source>
             <translation>Ajouter une couche table</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="216" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="222" />
             <source>Keep the measurements as a table layer in the project: the saved CSV table, rewritten as you measure (a temporary layer until a table is saved)</source>
             <translation>Conserver les mesures comme couche table dans le projet : la table CSV enregistrée, réécrite au fil des mesures (une couche temporaire tant qu'aucune table n'est enregistrée)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="274" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="280" />
             <source>Choose the folder of the photos first.</source>
             <translation>Choisissez d'abord le dossier des photos.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="277" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="283" />
             <source>Choose a GCP point layer first (fields: name, optional role and z).</source>
             <translation>Choisissez d'abord une couche de points d'appui (champs : name, role et z facultatifs).</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="301" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="307" />
             <source>{} GCPs, {} images</source>
             <translation>{} points d'appui, {} images</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="444" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="450" />
             <source>Load the images and the GCPs first.</source>
             <translation>Chargez d'abord les images et les points d'appui.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="602" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="478" />
+            <source>Refining needs an orientation: choose one and load again.</source>
+            <translation>L'affinage nécessite une orientation : choisissez-en une et rechargez.</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="489" />
+            <source>{} refined in {} images</source>
+            <translation>{} affiné dans {} images</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="635" />
             <source>GCP observations</source>
             <translation>Observations des points d'appui</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="303" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="309" />
             <source>; {} predicted positions</source>
             <translation> ; {} positions prédites</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="505" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="491" />
+            <source>; not in {}</source>
+            <translation> ; pas dans {}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="537" />
             <source>{} on {}: {} — {} measured, {} to do — zoom {:.2f}</source>
             <translation>{} sur {} : {} — {} mesurées, {} à faire — zoom {:.2f}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="324" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="330" />
             <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</source>
             <translation>{} : X {:.3f}, Y {:.3f}, Z {:.3f}{}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="325" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="331" />
             <source> (check point)</source>
             <translation> (point de contrôle)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="558" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="486" />
+            <source>Refinement failed: {}</source>
+            <translation>Échec de l'affinage : {}</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="486" />
+            <source>no image matched</source>
+            <translation>aucune image appariée</translation>
+        </message>
+        <message>
+            <location filename="../truortho_plugin/gcp_panel.py" line="591" />
             <source>Saved {} measurements to {}</source>
             <translation>{} mesures enregistrées dans {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="583" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="616" />
             <source>Loaded {} measurements from {}</source>
             <translation>{} mesures chargées depuis {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="283" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="289" />
             <source>GCP layer {!r} has no point</source>
             <translation>La couche de points d'appui {!r} ne contient aucun point</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="386" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="392" />
             <source>Cannot read the image {}</source>
             <translation>Impossible de lire l'image {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="604" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="637" />
             <source>Cannot open {} as a table layer</source>
             <translation>Impossible d'ouvrir {} comme couche table</translation>
         </message>
