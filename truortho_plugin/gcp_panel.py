@@ -302,6 +302,7 @@ class GcpPanel(QDockWidget):
             keep = [m for m in self.model.measurements() if m.gcp in {g.name for g in gcps}
                     and m.image in {p.name for p in photos}]  # fmt: skip
             model.replace_all(keep, "reload")
+            model.clear_history()  # an undo must not empty the table just reloaded
         self.model, self.orientation, self.folder = model, orientation, folder
         self._fill_table()
         text = tr("{} GCPs, {} images").format(len(gcps), len(photos))

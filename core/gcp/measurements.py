@@ -482,6 +482,11 @@ class MeasurementSet:
     def can_redo(self) -> bool:
         return bool(self._redo)
 
+    def clear_history(self) -> None:
+        """Forget the undo/redo stack (the measurements stay)."""
+        self._undo.clear()
+        self._redo.clear()
+
     def undo_label(self) -> str | None:
         return self._undo[-1][0] if self._undo else None
 

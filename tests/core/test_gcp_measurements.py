@@ -84,6 +84,9 @@ def test_place_move_delete_undo_redo(mset):
     mset.place("g0", im0, 5.0, 5.0)
     mset.place("g0", im0, 5.0, 5.0)  # unchanged: not a second command
     assert mset.undo() and not mset.can_undo and mset.revision == rev + 2
+    mset.place("g1", im1, 2.0, 3.0)
+    mset.clear_history()
+    assert not mset.can_undo and not mset.undo() and mset.get("g1", im1).x == 2.0
 
 
 def test_bad_input_changes_nothing(mset):

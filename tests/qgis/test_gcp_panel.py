@@ -139,6 +139,9 @@ def test_click_save_reload_undo(panel, block):
     assert m.get("B", image) == moved
     assert panel.undo() and panel.undo() and not panel.undo()
     assert len(m) == 0 and panel.table.item(r, c).text() != "●"
+    # a reload (Load again) keeps the measurements of GCPs and images that still exist, not undoable
+    assert panel.redo() and panel.load()
+    assert panel.model is not m and panel.model.measurements() == [meas] and not panel.model.can_undo
 
 
 def test_bad_clicks_and_files_change_nothing(panel, block):
