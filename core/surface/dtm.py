@@ -126,7 +126,7 @@ def _harmonic(z: np.ndarray, known: np.ndarray) -> np.ndarray:
     """Fill the unknown cells of ``z`` by harmonic interpolation from the ``known`` cells."""
     from scipy import ndimage
 
-    from .filter import _FOUR, _solve
+    from .filter.holes import _FOUR, _solve
 
     fill = ~known
     if not fill.any():

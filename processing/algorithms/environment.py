@@ -80,6 +80,8 @@ class EnvironmentAlgorithm(QgsProcessingAlgorithm):
     OUTPUT = "OUTPUT"
     VERSIONS = "VERSIONS"
     CLEAR_CACHE = "CLEAR_CACHE"
+    #: parameter defaults no core config defines (see TruOrthoAlgorithm.CONFIG_DEFAULTS)
+    OWN_DEFAULTS = {CLEAR_CACHE: "an action of this run, not a setting: off"}
 
     def name(self) -> str:
         return "environment"

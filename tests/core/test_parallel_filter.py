@@ -1,4 +1,4 @@
-"""Tile-parallel DSM filter (core/surface/filter.py on core/parallel): the same filtered DSM and
+"""Tile-parallel DSM filter (core/surface/filter/ on core/parallel): the same filtered DSM and
 statistics from every executor, the tile cache, the in-memory path.
 
 Acceptance (issue 8, DSM-filter part): in-process, a local Dask cluster of 2 worker processes and a
@@ -123,7 +123,7 @@ def test_each_pass_is_one_map_tiles_call_with_a_memory_estimate(files, reference
 
 
 def test_pass_two_in_write_batches_gives_the_same_result(files, reference, tmp_path, monkeypatch):
-    monkeypatch.setattr(F, "WRITE_BATCH_BYTES", 5 * 4 * TILE * TILE)  # 5 tiles per batch
+    monkeypatch.setattr(F.pipeline, "WRITE_BATCH_BYTES", 5 * 4 * TILE * TILE)  # 5 tiles per batch
     spy = _Spy()
     assert _same(_filter(files, tmp_path / "f.tif", executor=spy), reference)
     assert [c["n"] for c in spy.calls] == [12, 5, 5, 2]
