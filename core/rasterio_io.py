@@ -455,6 +455,59 @@ def read_raster(
     return data, grid, nodata
 
 
+def read_preview(path, max_side: int = 1200, band: int | None = 1, resampling: str = "nearest"):
+    """A raster reduced by a whole factor so that its larger side is at most ``max_side`` cells.
+
+    GDAL reads it from the file's overviews when they exist, so the memory is that of the
+    preview, not of the raster (a report of a large block never reads its full DSM).
+
+    Returns
+    -------
+    (data, grid, nodata)
+        As :func:`read_raster`; ``grid`` is the preview's (cells about ``factor`` times larger,
+        with the raster's origin: for display, not for measuring).
+    """
+    import math
+
+    from rasterio.enums import Resampling
+
+    grid = raster_grid(path, require_crs=False)
+    if max_side < 1:
+        raise InputError(f"{path}: a preview needs max_side >= 1, got {max_side!r}")
+    factor = max(1, math.ceil(max(grid.rows, grid.cols) / int(max_side)))
+    if factor == 1:
+        return read_raster(path, band)
+    pg = grid.scaled(factor)
+    with _open(path) as ds:
+        if band is not None and not 1 <= band <= ds.count:
+            raise InputError(f"{path}: band {band} does not exist (the raster has {ds.count} band(s))")
+        bands = ds.count if band is None else 1
+        data = ds.read(
+            band if band is not None else None,
+            out_shape=(bands, pg.rows, pg.cols) if band is None else (pg.rows, pg.cols),
+            resampling=getattr(Resampling, resampling),
+        )
+        nodata = ds.nodata
+    if data.dtype.kind == "f" and nodata is not None and not np.isnan(nodata):
+        data = np.where(data == nodata, np.float32(np.nan), data).astype(data.dtype)
+    return data, pg, nodata
+
+
+def valid_share(path, band: int = 1, block: int = 1024) -> float:
+    """Share of the cells of ``band`` that hold data (not nodata, not NaN), read window by window."""
+    grid = raster_grid(path, require_crs=False)
+    valid = 0
+    for t in grid.tiles(block):
+        data, _, _ = read_raster(path, band, t.core)
+        if data.dtype.kind == "f":
+            valid += int(np.isfinite(data).sum())
+        else:
+            with _open(path) as ds:
+                nod = ds.nodata
+            valid += int(data.size if nod is None else (data != nod).sum())
+    return valid / max(grid.rows * grid.cols, 1)
+
+
 def read_onto_grid(
     path, grid: RasterGrid, band: int = 1, resampling: str = "bilinear", dtype="float32"
 ) -> np.ndarray:

@@ -190,7 +190,7 @@ def pipeline_report(
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from .rasterio_io import read_raster
+    from .rasterio_io import read_preview, valid_share
 
     report = Report(title)
     if orient_report is not None:
@@ -209,8 +209,10 @@ def pipeline_report(
     report.data["trueortho"] = {k: v for k, v in tres.stats.items() if isinstance(v, int | float | str)}
     report.summary["DSM resolution [m]"] = s["resolution"]
     report.summary["DSM completeness (raw) [%]"] = round(100 * s["completeness"], 2)
-    dsm, grid, _ = read_raster(dsm_path)
-    report.summary["DSM completeness (filtered) [%]"] = round(100 * float(np.isfinite(dsm).mean()), 2)
+    # previews (from the overviews): a large block's full DSM and ortho are never read at once
+    dsm, grid, _ = read_preview(dsm_path, 1200)
+    filtered_share = valid_share(dsm_path)
+    report.summary["DSM completeness (filtered) [%]"] = round(100 * filtered_share, 2)
     st = tres.stats
     occl = float(st.get("cells_occluded", 0)) / max(1, int(st.get("rows", 1)) * int(st.get("cols", 1)))
     report.summary["true ortho coverage [%]"] = round(100 * float(st["coverage"]), 2)
@@ -230,12 +232,11 @@ def pipeline_report(
     ax.imshow(np.where(np.isfinite(dsm), shade, np.nan), cmap="gray", extent=ext)
     im = ax.imshow(np.where(np.isfinite(dsm), dsm, np.nan), cmap="terrain", alpha=0.45, extent=ext)
     fig.colorbar(im, ax=ax, label="height [m]")
-    ax.set_title(f"Filtered DSM ({100 * float(np.isfinite(dsm).mean()):.1f} % of the cells)")
+    ax.set_title(f"Filtered DSM ({100 * filtered_share:.1f} % of the cells)")
     report.add_figure("DSM hillshade (filtered DSM)", fig)
     # true ortho preview
-    ortho, og, _ = read_raster(ortho_path, band=None)
-    step = max(1, int(np.ceil(max(ortho.shape[1:]) / 1200)))
-    o = np.moveaxis(ortho[:, ::step, ::step], 0, -1)
+    ortho, og, _ = read_preview(ortho_path, 1200, band=None)
+    o = np.moveaxis(ortho, 0, -1)
     fig, ax = plt.subplots(figsize=(7, 6))
     if o.shape[2] >= 4:
         rgb = o[:, :, :3].astype(np.float32)

@@ -11,7 +11,9 @@ from truortho.core.rasterio_io import (
     RasterWriter,
     raster_grid,
     read_onto_grid,
+    read_preview,
     read_raster,
+    valid_share,
     write_point_cloud,
     write_raster,
 )
@@ -71,6 +73,25 @@ def test_raster_writer_tiles_roundtrip_and_nodata(tmp_path):
     np.testing.assert_allclose(data[~np.isnan(data)], full[~np.isnan(full)])
     assert raster_grid(out).crs == "EPSG:32632"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["dsm.tif"]
+
+
+def test_preview_and_valid_share_read_by_windows(tmp_path):
+    """The report's previews come from the overviews at the reduced size; the valid share is exact."""
+    g = RasterGrid(500000.0, 5600000.0, 0.5, 2500, 1300, "EPSG:32632")
+    z = np.add.outer(np.arange(g.rows), np.arange(g.cols)).astype(np.float32)
+    z[100:300, 200:900] = np.nan
+    write_raster(tmp_path / "z.tif", np.where(np.isnan(z), -9999.0, z), g, nodata=-9999.0, overviews=True)
+    p, pg, nod = read_preview(tmp_path / "z.tif", 500)
+    assert p.shape == (500, 260) and pg.res == pytest.approx(2.5) and nod == -9999.0
+    assert np.nanmax(np.abs(p - z[2::5, 2::5])) <= 5 and np.isnan(p[30, 60])
+    assert read_preview(tmp_path / "z.tif", 5000)[0].shape == g.shape
+    assert valid_share(tmp_path / "z.tif", block=700) == pytest.approx(np.isfinite(z).mean())
+    rgb = np.zeros((3, g.rows, g.cols), np.uint8)
+    write_raster(tmp_path / "o.tif", rgb, g, nodata=0)
+    assert read_preview(tmp_path / "o.tif", 1000, band=None)[0].shape == (3, 834, 434)
+    assert valid_share(tmp_path / "o.tif") == 0.0
+    with pytest.raises(InputError, match="max_side"):
+        read_preview(tmp_path / "z.tif", 0)
 
 
 def test_failed_write_leaves_nothing_and_keeps_old_file(tmp_path):
@@ -176,9 +197,11 @@ def test_writers_closed_early_in_threads_are_complete_and_leave_no_temporary(tmp
     g = RasterGrid(0.0, 600.0, 1.0, 600, 600, "EPSG:32632")
     data = np.arange(600 * 600, dtype=np.float32).reshape(1, 600, 600)
     paths = [tmp_path / f"r{i}.tif" for i in range(3)]
-    with RasterWriter(paths[0], g, 1, "float32", cog=True) as a, RasterWriter(
-        paths[1], g, 1, "float32", overviews=True
-    ) as b, RasterWriter(paths[2], g, 1, "float32") as c:
+    with (
+        RasterWriter(paths[0], g, 1, "float32", cog=True) as a,
+        RasterWriter(paths[1], g, 1, "float32", overviews=True) as b,
+        RasterWriter(paths[2], g, 1, "float32") as c,
+    ):
         for w in (a, b, c):
             w.write(data)
         with ThreadPoolExecutor(3) as pool:
