@@ -9,7 +9,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source scripts/env.sh &&
 
-.PHONY: setup test lint pytest demo bench acceptance acceptance-real zip
+.PHONY: setup test lint pytest demo bench acceptance acceptance-real zip docs
 
 setup:
 	bash scripts/setup.sh
@@ -49,6 +49,10 @@ acceptance: setup
 # Real photo blocks through the whole pipeline (no truth DSM): make acceptance-real REAL_ARGS="--blocks sample,brighton"
 acceptance-real: setup
 	$(ENV) $(PY) -P bench/real_blocks.py $(REAL_ARGS)
+
+# docs/algorithms.md from the algorithms and their help (tests/qgis/test_docs.py checks it is fresh).
+docs: setup
+	$(ENV) $(PY) -P scripts/make_docs.py
 
 # The installable plugin zip (truortho/ at its root; no tests, benchmarks or data beyond the demo sample).
 zip: setup

@@ -16,7 +16,7 @@ older file of the same name before the new one is ready).
   :func:`read_point_cloud_arrays` reads them back.
 * :func:`write_seamlines`: the true orthophoto's seamline polygons as a GeoPackage.
 
-GDAL-linked packages come from the same distribution as QGIS (README,
+GDAL-linked packages come from the same distribution as QGIS (docs/install.md,
 "Dependency policy"); rasterio is imported lazily.
 """
 

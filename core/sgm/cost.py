@@ -64,7 +64,7 @@ _FLAT = -2.0
 _STRIP = 32
 #: Measures offered by :func:`multi_image_cost`.
 MEASURES = ("gradient", "ncc", "census")
-#: Default measure (chosen by measurement, see the README).
+#: Default measure (chosen by measurement, see docs/methods.md).
 DEFAULT_MEASURE = "gradient"
 #: Default window radius (5 x 5 cells).
 DEFAULT_RADIUS = 2
