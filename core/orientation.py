@@ -21,7 +21,8 @@ JSON format ``truortho-orientation`` version 1 (documented in README)::
                  "observations": [[point_index, image_index, x, y], ...]},   # optional
       "gcps": [{"name": "g1", "role": "gcp" | "check", "xyz": [E, N, H],  # world frame
                 "sigma": [sx, sy, sz] | null,
-                "observations": [{"image": "IMG_1.jpg", "x": px, "y": py}]}]    # optional
+                "observations": [{"image": "IMG_1.jpg", "x": px, "y": py,
+                                  "sigma": px_sigma}]}]    # optional; sigma optional (pixels)
     }
 
 Image ``path``s are relative to ``image_root`` and may not be absolute or
@@ -88,13 +89,19 @@ class Image:
 
 @dataclass
 class GCP:
-    """A ground control or check point: world coordinates and image measurements."""
+    """A ground control or check point: world coordinates and image measurements.
+
+    ``obs_sigma`` maps an image name to the standard deviation (pixels, the same in x and y) of
+    the measurement on that image, e.g. from least-squares matching (:mod:`.gcp.lsm`); the
+    bundle weights that observation with it. Images not in it get the adjustment's default.
+    """
 
     name: str
     xyz: np.ndarray
     role: str = "gcp"
     sigma: np.ndarray | None = None
     observations: list[tuple[str, float, float]] = field(default_factory=list)
+    obs_sigma: dict[str, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         xyz = np.asarray(self.xyz, dtype=np.float64).reshape(-1)
@@ -108,6 +115,19 @@ class GCP:
             if s.shape != (3,) or not np.all(np.isfinite(s)) or np.any(s <= 0):
                 raise InputError(f"GCP {self.name!r}: sigma must be 3 positive numbers")
             self.sigma = s
+        obs_sigma = {}
+        for image, v in dict(self.obs_sigma or {}).items():
+            try:
+                fv = float(v)
+            except (TypeError, ValueError):
+                fv = float("nan")
+            if not (math.isfinite(fv) and fv > 0):
+                raise InputError(
+                    f"GCP {self.name!r}: the measurement sigma on image {image!r} must be a positive number, "
+                    f"got {v!r}"
+                )
+            obs_sigma[str(image)] = fv
+        self.obs_sigma = obs_sigma
 
 
 @dataclass
@@ -273,7 +293,9 @@ class Orientation:
                     "xyz": [float(v) for v in g.xyz],
                     "sigma": None if g.sigma is None else [float(v) for v in g.sigma],
                     "observations": [
-                        {"image": i, "x": float(x), "y": float(y)} for i, x, y in g.observations
+                        {"image": i, "x": float(x), "y": float(y)}
+                        | ({"sigma": g.obs_sigma[i]} if i in g.obs_sigma else {})
+                        for i, x, y in g.observations
                     ],
                 }
                 for g in self.gcps
@@ -490,6 +512,7 @@ def _from_dict(d: object, source: str, base_dir: str | None) -> Orientation:
         xyz = r.vec(g.get("xyz"), 3, f"gcps[{i}].xyz")
         sigma = None if g.get("sigma") is None else r.vec(g["sigma"], 3, f"gcps[{i}].sigma")
         gobs: list[tuple[str, float, float]] = []
+        gsig: dict[str, float] = {}
         for k, o in enumerate(r.lst(g.get("observations", []), f"gcps[{i}].observations")):
             o = r.obj(o, f"gcps[{i}].observations[{k}]")
             gobs.append(
@@ -499,8 +522,10 @@ def _from_dict(d: object, source: str, base_dir: str | None) -> Orientation:
                     r.num(o.get("y"), f"gcps[{i}].observations[{k}].y"),
                 )
             )
+            if o.get("sigma") is not None:
+                gsig[gobs[-1][0]] = r.num(o.get("sigma"), f"gcps[{i}].observations[{k}].sigma")
         try:
-            gcps.append(GCP(name, xyz, g.get("role", "gcp"), sigma, gobs))
+            gcps.append(GCP(name, xyz, g.get("role", "gcp"), sigma, gobs, gsig))
         except InputError as err:
             r.fail(f"gcps[{i}]", str(err))
 

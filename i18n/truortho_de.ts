@@ -289,52 +289,52 @@
             <translation>Bodenfilter mit {:.2f} m: {:.1f} % der Zellen sind Boden</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="88" />
+            <location filename="../processing/algorithms/environment.py" line="90" />
             <source>Check environment</source>
             <translation>Umgebung prüfen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="97" />
+            <location filename="../processing/algorithms/environment.py" line="99" />
             <source>Reports the versions of QGIS, GDAL, rasterio, numpy, numba, OpenCV and pyproj that TruOrtho runs with, and writes them to a JSON file. Fails if rasterio is linked to a different GDAL than QGIS. Also reports TruOrtho's cache folder (compiled kernels and image features; the environment variable TRUORTHO_CACHE_DIR moves it, default the per-user cache folder of the system) and its size; CLEAR_CACHE empties it.</source>
             <translation type="unfinished" />
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="141" />
+            <location filename="../processing/algorithms/environment.py" line="143" />
             <source>rasterio is linked to GDAL {} but QGIS uses GDAL {}: use Debian's python3-rasterio</source>
             <translation>rasterio ist gegen GDAL {} gelinkt, QGIS verwendet aber GDAL {}: verwenden Sie Debians python3-rasterio</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="111" />
+            <location filename="../processing/algorithms/environment.py" line="113" />
             <source>Versions (JSON)</source>
             <translation>Versionen (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="111" />
+            <location filename="../processing/algorithms/environment.py" line="113" />
             <source>JSON files (*.json)</source>
             <translation>JSON-Dateien (*.json)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="117" />
+            <location filename="../processing/algorithms/environment.py" line="119" />
             <source>Clear the cache (compiled kernels, image features)</source>
             <translation type="unfinished" />
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="122" />
+            <location filename="../processing/algorithms/environment.py" line="124" />
             <source>Versions as JSON text</source>
             <translation>Versionen als JSON-Text</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="129" />
+            <location filename="../processing/algorithms/environment.py" line="131" />
             <source>Cache cleared: {:.1f} MB freed</source>
             <translation type="unfinished" />
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="138" />
+            <location filename="../processing/algorithms/environment.py" line="140" />
             <source>Not importable: {}</source>
             <translation>Nicht importierbar: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="134" />
+            <location filename="../processing/algorithms/environment.py" line="136" />
             <source>not available</source>
             <translation>nicht verfügbar</translation>
         </message>
@@ -1839,87 +1839,92 @@
             <translation>Optionaler Ordner für einen EPT-Datensatz der zusammengeführten Wolke.</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="219" />
+            <location filename="../processing/layers.py" line="222" />
             <source>GCP</source>
             <translation>Passpunkt</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="307" />
+            <location filename="../processing/layers.py" line="333" />
             <source>Observation</source>
             <translation>Beobachtung</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="344" />
+            <location filename="../processing/layers.py" line="374" />
             <source>GCPS and OBSERVATIONS must be given together</source>
             <translation>GCPS und OBSERVATIONS müssen zusammen angegeben werden</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="51" />
+            <location filename="../processing/layers.py" line="54" />
             <source>QGIS cannot read the CRS {!r}</source>
             <translation>QGIS kann das KBS {!r} nicht lesen</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="182" />
+            <location filename="../processing/layers.py" line="185" />
             <source>{}: expected a finite number, got {!r}</source>
             <translation>{}: endliche Zahl erwartet, erhalten: {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="191" />
+            <location filename="../processing/layers.py" line="194" />
             <source>{} layer {!r} lacks the field(s) {}; expected fields: {}</source>
             <translation>Layer {} {!r}: es fehlen die Felder {}; erwartete Felder: {}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="180" />
+            <location filename="../processing/layers.py" line="316" />
+            <source>Observation table {!r}, feature {}: sigma must be positive, got {}</source>
+            <translation>Beobachtungstabelle {!r}, Objekt {}: sigma muss positiv sein, erhalten {}</translation>
+        </message>
+        <message>
+            <location filename="../processing/layers.py" line="183" />
             <source>{}: expected a number, got {!r}</source>
             <translation>{}: Zahl erwartet, erhalten: {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="241" />
+            <location filename="../processing/layers.py" line="244" />
             <source>GCP layer {!r}: feature {} has no name</source>
             <translation>Passpunktlayer {!r}: Objekt {} hat keinen Namen</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="246" />
+            <location filename="../processing/layers.py" line="249" />
             <source>GCP layer {!r}: the name {!r} appears twice</source>
             <translation>Passpunktlayer {!r}: der Name {!r} kommt doppelt vor</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="252" />
+            <location filename="../processing/layers.py" line="255" />
             <source>GCP layer {!r}: GCP {!r} has no geometry</source>
             <translation>Passpunktlayer {!r}: Passpunkt {!r} hat keine Geometrie</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="260" />
+            <location filename="../processing/layers.py" line="263" />
             <source>GCP layer {!r}: GCP {!r} is not a single point</source>
             <translation>Passpunktlayer {!r}: Passpunkt {!r} ist kein Einzelpunkt</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="266" />
+            <location filename="../processing/layers.py" line="269" />
             <source>GCP layer {!r}: GCP {!r} has no height: use PointZ geometries or a 'z' field</source>
             <translation>Passpunktlayer {!r}: Passpunkt {!r} hat keine Höhe: verwenden Sie PointZ-Geometrien oder ein Feld 'z'</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="315" />
+            <location filename="../processing/layers.py" line="342" />
             <source>Observation table {!r}, feature {}: unknown GCP {!r}</source>
             <translation>Beobachtungstabelle {!r}, Objekt {}: unbekannter Passpunkt {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="321" />
+            <location filename="../processing/layers.py" line="348" />
             <source>Observation table {!r}, feature {}: unknown image {!r}</source>
             <translation>Beobachtungstabelle {!r}, Objekt {}: unbekanntes Bild {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="329" />
+            <location filename="../processing/layers.py" line="356" />
             <source>Observation table {!r}, feature {}: x and y are required</source>
             <translation>Beobachtungstabelle {!r}, Objekt {}: x und y sind erforderlich</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="280" />
+            <location filename="../processing/layers.py" line="283" />
             <source>GCP layer {!r}: GCP {!r} has role {!r}; expected 'gcp' or 'check'</source>
             <translation>Passpunktlayer {!r}: Passpunkt {!r} hat die Rolle {!r}; erwartet wird 'gcp' oder 'check'</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="293" />
+            <location filename="../processing/layers.py" line="296" />
             <source>GCP {!r}: sigmas must be positive</source>
             <translation>Passpunkt {!r}: Sigmas müssen positiv sein</translation>
         </message>
@@ -2039,42 +2044,42 @@
             <translation>Orientierungen (*.json *.txt);;Alle Dateien (*)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="360" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="361" />
             <source>predicted</source>
             <translation>vorhergesagt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="360" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="361" />
             <source>not measured</source>
             <translation>nicht gemessen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="555" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="556" />
             <source>Save the observation table</source>
             <translation>Beobachtungstabelle speichern</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="555" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="556" />
             <source>CSV (*.csv)</source>
             <translation>CSV (*.csv)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="561" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="562" />
             <source>Save gcp_list.txt</source>
             <translation>gcp_list.txt speichern</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="562" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="563" />
             <source>gcp_list (*.txt)</source>
             <translation>gcp_list (*.txt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="567" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="568" />
             <source>Open measurements</source>
             <translation>Messungen öffnen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="568" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="569" />
             <source>Observation tables (*.csv *.txt)</source>
             <translation>Beobachtungstabellen (*.csv *.txt)</translation>
         </message>
@@ -2164,72 +2169,72 @@
             <translation>Zuerst einen GCP-Punktlayer wählen (Felder: name, optional role und z).</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="307" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="308" />
             <source>{} GCPs, {} images</source>
             <translation>{} GCPs, {} Bilder</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="450" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="451" />
             <source>Load the images and the GCPs first.</source>
             <translation>Zuerst die Bilder und die GCPs laden.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="478" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="479" />
             <source>Refining needs an orientation: choose one and load again.</source>
             <translation>Verfeinern benötigt eine Orientierung: eine wählen und erneut laden.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="489" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="490" />
             <source>{} refined in {} images</source>
             <translation>{} in {} Bildern verfeinert</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="635" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="636" />
             <source>GCP observations</source>
             <translation>GCP-Beobachtungen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="309" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="310" />
             <source>; {} predicted positions</source>
             <translation>; {} vorhergesagte Positionen</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="491" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="492" />
             <source>; not in {}</source>
             <translation>; nicht in {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="537" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="538" />
             <source>{} on {}: {} — {} measured, {} to do — zoom {:.2f}</source>
             <translation>{} in {}: {} — {} gemessen, {} offen — Zoom {:.2f}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="330" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="331" />
             <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</source>
             <translation>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="331" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="332" />
             <source> (check point)</source>
             <translation> (Kontrollpunkt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="486" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="487" />
             <source>Refinement failed: {}</source>
             <translation>Verfeinerung fehlgeschlagen: {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="486" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="487" />
             <source>no image matched</source>
             <translation>kein Bild zugeordnet</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="591" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="592" />
             <source>Saved {} measurements to {}</source>
             <translation>{} Messungen in {} gespeichert</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="616" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="617" />
             <source>Loaded {} measurements from {}</source>
             <translation>{} Messungen aus {} geladen</translation>
         </message>
@@ -2239,12 +2244,12 @@
             <translation>GCP-Layer {!r} enthält keinen Punkt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="392" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="393" />
             <source>Cannot read the image {}</source>
             <translation>Das Bild {} kann nicht gelesen werden</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="637" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="638" />
             <source>Cannot open {} as a table layer</source>
             <translation>{} kann nicht als Tabellenlayer geöffnet werden</translation>
         </message>

@@ -289,52 +289,52 @@
             <translation>Filtre de sol à {:.2f} m : {:.1f} % des cellules sont du sol</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="88" />
+            <location filename="../processing/algorithms/environment.py" line="90" />
             <source>Check environment</source>
             <translation>Vérifier l'environnement</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="97" />
+            <location filename="../processing/algorithms/environment.py" line="99" />
             <source>Reports the versions of QGIS, GDAL, rasterio, numpy, numba, OpenCV and pyproj that TruOrtho runs with, and writes them to a JSON file. Fails if rasterio is linked to a different GDAL than QGIS. Also reports TruOrtho's cache folder (compiled kernels and image features; the environment variable TRUORTHO_CACHE_DIR moves it, default the per-user cache folder of the system) and its size; CLEAR_CACHE empties it.</source>
             <translation type="unfinished" />
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="141" />
+            <location filename="../processing/algorithms/environment.py" line="143" />
             <source>rasterio is linked to GDAL {} but QGIS uses GDAL {}: use Debian's python3-rasterio</source>
             <translation>rasterio est lié à GDAL {} mais QGIS utilise GDAL {} : utilisez le paquet python3-rasterio de Debian</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="111" />
+            <location filename="../processing/algorithms/environment.py" line="113" />
             <source>Versions (JSON)</source>
             <translation>Versions (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="111" />
+            <location filename="../processing/algorithms/environment.py" line="113" />
             <source>JSON files (*.json)</source>
             <translation>Fichiers JSON (*.json)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="117" />
+            <location filename="../processing/algorithms/environment.py" line="119" />
             <source>Clear the cache (compiled kernels, image features)</source>
             <translation type="unfinished" />
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="122" />
+            <location filename="../processing/algorithms/environment.py" line="124" />
             <source>Versions as JSON text</source>
             <translation>Versions en texte JSON</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="129" />
+            <location filename="../processing/algorithms/environment.py" line="131" />
             <source>Cache cleared: {:.1f} MB freed</source>
             <translation type="unfinished" />
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="138" />
+            <location filename="../processing/algorithms/environment.py" line="140" />
             <source>Not importable: {}</source>
             <translation>Non importable : {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/environment.py" line="134" />
+            <location filename="../processing/algorithms/environment.py" line="136" />
             <source>not available</source>
             <translation>non disponible</translation>
         </message>
@@ -1839,87 +1839,92 @@
             <translation>Dossier facultatif pour un jeu de données EPT du nuage fusionné.</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="219" />
+            <location filename="../processing/layers.py" line="222" />
             <source>GCP</source>
             <translation>Point d'appui</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="307" />
+            <location filename="../processing/layers.py" line="333" />
             <source>Observation</source>
             <translation>Observation</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="344" />
+            <location filename="../processing/layers.py" line="374" />
             <source>GCPS and OBSERVATIONS must be given together</source>
             <translation>GCPS et OBSERVATIONS doivent être fournis ensemble</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="51" />
+            <location filename="../processing/layers.py" line="54" />
             <source>QGIS cannot read the CRS {!r}</source>
             <translation>QGIS ne peut pas lire le SCR {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="182" />
+            <location filename="../processing/layers.py" line="185" />
             <source>{}: expected a finite number, got {!r}</source>
             <translation>{} : nombre fini attendu, reçu {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="191" />
+            <location filename="../processing/layers.py" line="194" />
             <source>{} layer {!r} lacks the field(s) {}; expected fields: {}</source>
             <translation>Couche {} {!r} : champ(s) manquant(s) {} ; champs attendus : {}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="180" />
+            <location filename="../processing/layers.py" line="316" />
+            <source>Observation table {!r}, feature {}: sigma must be positive, got {}</source>
+            <translation>Table d'observations {!r}, entité {} : sigma doit être positif, reçu {}</translation>
+        </message>
+        <message>
+            <location filename="../processing/layers.py" line="183" />
             <source>{}: expected a number, got {!r}</source>
             <translation>{} : nombre attendu, reçu {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="241" />
+            <location filename="../processing/layers.py" line="244" />
             <source>GCP layer {!r}: feature {} has no name</source>
             <translation>Couche de points d'appui {!r} : l'entité {} n'a pas de nom</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="246" />
+            <location filename="../processing/layers.py" line="249" />
             <source>GCP layer {!r}: the name {!r} appears twice</source>
             <translation>Couche de points d'appui {!r} : le nom {!r} apparaît deux fois</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="252" />
+            <location filename="../processing/layers.py" line="255" />
             <source>GCP layer {!r}: GCP {!r} has no geometry</source>
             <translation>Couche de points d'appui {!r} : le point d'appui {!r} n'a pas de géométrie</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="260" />
+            <location filename="../processing/layers.py" line="263" />
             <source>GCP layer {!r}: GCP {!r} is not a single point</source>
             <translation>Couche de points d'appui {!r} : le point d'appui {!r} n'est pas un point simple</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="266" />
+            <location filename="../processing/layers.py" line="269" />
             <source>GCP layer {!r}: GCP {!r} has no height: use PointZ geometries or a 'z' field</source>
             <translation>Couche de points d'appui {!r} : le point d'appui {!r} n'a pas de hauteur : utilisez des géométries PointZ ou un champ 'z'</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="315" />
+            <location filename="../processing/layers.py" line="342" />
             <source>Observation table {!r}, feature {}: unknown GCP {!r}</source>
             <translation>Table d'observations {!r}, entité {} : point d'appui inconnu {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="321" />
+            <location filename="../processing/layers.py" line="348" />
             <source>Observation table {!r}, feature {}: unknown image {!r}</source>
             <translation>Table d'observations {!r}, entité {} : image inconnue {!r}</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="329" />
+            <location filename="../processing/layers.py" line="356" />
             <source>Observation table {!r}, feature {}: x and y are required</source>
             <translation>Table d'observations {!r}, entité {} : x et y sont obligatoires</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="280" />
+            <location filename="../processing/layers.py" line="283" />
             <source>GCP layer {!r}: GCP {!r} has role {!r}; expected 'gcp' or 'check'</source>
             <translation>Couche de points d'appui {!r} : le point d'appui {!r} a le rôle {!r} ; 'gcp' ou 'check' attendu</translation>
         </message>
         <message>
-            <location filename="../processing/layers.py" line="293" />
+            <location filename="../processing/layers.py" line="296" />
             <source>GCP {!r}: sigmas must be positive</source>
             <translation>Point d'appui {!r} : les sigmas doivent être positifs</translation>
         </message>
@@ -2039,42 +2044,42 @@
             <translation>Orientations (*.json *.txt);;Tous les fichiers (*)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="360" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="361" />
             <source>predicted</source>
             <translation>prédit</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="360" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="361" />
             <source>not measured</source>
             <translation>non mesuré</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="555" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="556" />
             <source>Save the observation table</source>
             <translation>Enregistrer la table des observations</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="555" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="556" />
             <source>CSV (*.csv)</source>
             <translation>CSV (*.csv)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="561" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="562" />
             <source>Save gcp_list.txt</source>
             <translation>Enregistrer gcp_list.txt</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="562" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="563" />
             <source>gcp_list (*.txt)</source>
             <translation>gcp_list (*.txt)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="567" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="568" />
             <source>Open measurements</source>
             <translation>Ouvrir des mesures</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="568" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="569" />
             <source>Observation tables (*.csv *.txt)</source>
             <translation>Tables d'observations (*.csv *.txt)</translation>
         </message>
@@ -2164,72 +2169,72 @@
             <translation>Choisissez d'abord une couche de points d'appui (champs : name, role et z facultatifs).</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="307" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="308" />
             <source>{} GCPs, {} images</source>
             <translation>{} points d'appui, {} images</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="450" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="451" />
             <source>Load the images and the GCPs first.</source>
             <translation>Chargez d'abord les images et les points d'appui.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="478" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="479" />
             <source>Refining needs an orientation: choose one and load again.</source>
             <translation>L'affinage nécessite une orientation : choisissez-en une et rechargez.</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="489" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="490" />
             <source>{} refined in {} images</source>
             <translation>{} affiné dans {} images</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="635" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="636" />
             <source>GCP observations</source>
             <translation>Observations des points d'appui</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="309" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="310" />
             <source>; {} predicted positions</source>
             <translation> ; {} positions prédites</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="491" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="492" />
             <source>; not in {}</source>
             <translation> ; pas dans {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="537" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="538" />
             <source>{} on {}: {} — {} measured, {} to do — zoom {:.2f}</source>
             <translation>{} sur {} : {} — {} mesurées, {} à faire — zoom {:.2f}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="330" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="331" />
             <source>{}: X {:.3f}, Y {:.3f}, Z {:.3f}{}</source>
             <translation>{} : X {:.3f}, Y {:.3f}, Z {:.3f}{}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="331" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="332" />
             <source> (check point)</source>
             <translation> (point de contrôle)</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="486" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="487" />
             <source>Refinement failed: {}</source>
             <translation>Échec de l'affinage : {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="486" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="487" />
             <source>no image matched</source>
             <translation>aucune image appariée</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="591" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="592" />
             <source>Saved {} measurements to {}</source>
             <translation>{} mesures enregistrées dans {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="616" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="617" />
             <source>Loaded {} measurements from {}</source>
             <translation>{} mesures chargées depuis {}</translation>
         </message>
@@ -2239,12 +2244,12 @@
             <translation>La couche de points d'appui {!r} ne contient aucun point</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="392" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="393" />
             <source>Cannot read the image {}</source>
             <translation>Impossible de lire l'image {}</translation>
         </message>
         <message>
-            <location filename="../truortho_plugin/gcp_panel.py" line="637" />
+            <location filename="../truortho_plugin/gcp_panel.py" line="638" />
             <source>Cannot open {} as a table layer</source>
             <translation>Impossible d'ouvrir {} comme couche table</translation>
         </message>

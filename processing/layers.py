@@ -11,7 +11,8 @@ The one place where the project's vector schemas live:
   optional sigmas in metres ``sigma_xy`` and ``sigma_z`` (or ``sigma_x``,
   ``sigma_y``, ``sigma_z``).
 * **Observation table** (no geometry): ``gcp`` (name), ``image`` (image name),
-  ``x``, ``y`` (pixels; (0, 0) = centre of the top-left pixel, x right, y down).
+  ``x``, ``y`` (pixels; (0, 0) = centre of the top-left pixel, x right, y down); optional
+  ``sigma_x``, ``sigma_y`` or ``sigma`` (pixels): the measurement's weight in the bundle.
 """
 
 from __future__ import annotations
@@ -38,6 +39,8 @@ from .i18n import tr
 
 GCP_REQUIRED_FIELDS = ("name",)
 OBSERVATION_FIELDS = ("gcp", "image", "x", "y")
+#: optional standard deviations of a measurement, pixels (detecttargets writes sigma_x, sigma_y)
+OBSERVATION_SIGMA_FIELDS = ("sigma", "sigma_x", "sigma_y")
 
 
 def qgs_crs(text: str | None) -> QgsCoordinateReferenceSystem:
@@ -296,17 +299,41 @@ def read_gcp_layer(
     return gcps
 
 
+def _observation_sigma(feat, fields: list[str], layer_name: str) -> float | None:
+    """Isotropic sigma (px) of one measurement: ``sigma``, or the RMS of ``sigma_x``/``sigma_y``."""
+    values = {f.lower(): _number(_value(feat, f), f"observation {feat.id()} {f}") for f in fields}
+    if values.get("sigma") is not None:
+        s = values["sigma"]
+    else:
+        sx, sy = values.get("sigma_x"), values.get("sigma_y")
+        if sx is None and sy is None:
+            return None
+        sx = sy if sx is None else sx
+        sy = sx if sy is None else sy
+        s = math.sqrt((sx * sx + sy * sy) / 2.0)  # type: ignore[operator]
+    if not s > 0:  # type: ignore[operator]
+        raise QgsProcessingException(
+            tr("Observation table {!r}, feature {}: sigma must be positive, got {}").format(
+                layer_name, feat.id(), s
+            )
+        )
+    return float(s)  # type: ignore[arg-type]
+
+
 def read_observation_table(layer, gcps: list[GCP], image_names: set[str] | None = None) -> None:
     """Attach image measurements from a table to ``gcps`` (in place).
 
-    Raises ``QgsProcessingException`` for missing fields, an unknown GCP or
-    image name, or non-numeric pixel coordinates.
+    Optional ``sigma_x``, ``sigma_y`` (or one ``sigma``) fields in pixels become the
+    measurement's weight in the bundle (``GCP.obs_sigma``: one sigma, the RMS of the two);
+    empty values leave the adjustment's default. Raises ``QgsProcessingException`` for missing
+    fields, an unknown GCP or image name, non-numeric pixel coordinates or a sigma <= 0.
     """
     if layer is None:
         return
     _require_fields(layer, OBSERVATION_FIELDS, tr("Observation"))
     by_name = {g.name: g for g in gcps}
     names = {k: _field_name(layer, k) for k in OBSERVATION_FIELDS}
+    sig_f = [f for f in (_field_name(layer, k) for k in OBSERVATION_SIGMA_FIELDS) if f]
     for feat in layer.getFeatures():
         gname = str(_value(feat, names["gcp"]) or "").strip()
         image = str(_value(feat, names["image"]) or "").strip()
@@ -329,6 +356,9 @@ def read_observation_table(layer, gcps: list[GCP], image_names: set[str] | None 
                 tr("Observation table {!r}, feature {}: x and y are required").format(layer.name(), feat.id())
             )
         by_name[gname].observations.append((image, x, y))
+        sigma = _observation_sigma(feat, sig_f, layer.name())
+        if sigma is not None:
+            by_name[gname].obs_sigma[image] = sigma
 
 
 def ground_control(gcp_layer, obs_layer, crs, transform_context):

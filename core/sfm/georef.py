@@ -42,6 +42,7 @@ class GeorefConfig:
 
     gcp_sigma_xy: float = 0.02
     gcp_sigma_z: float = 0.03
+    #: image measurement sigma of GCPs without their own (``GCP.obs_sigma``)
     gcp_obs_sigma_px: float = 1.0
     gps_sigma_xy: float = 3.0
     gps_sigma_z: float = 5.0
@@ -149,7 +150,7 @@ def reject_gcp_outliers(
             continue
         fixes = []
         for k in range(len(obs)):
-            trial = GCP(g.name, g.xyz, g.role, g.sigma, [o for j, o in enumerate(obs) if j != k])
+            trial = GCP(g.name, g.xyz, g.role, g.sigma, [o for j, o in enumerate(obs) if j != k], g.obs_sigma)
             xyz_k, _, err_k = triangulate_gcps(block, [trial])
             if np.isfinite(xyz_k[0, 0]) and err_k[0] <= max_error_px:
                 fixes.append((err_k[0], k, trial))
@@ -337,7 +338,7 @@ def georeference(
                     obs_img.append(np.array([index[name]]))
                     obs_pt.append(np.array([pid]))
                     obs_xy.append(np.array([[x, y]]))
-                    sig.append(np.array([cfg.gcp_obs_sigma_px]))
+                    sig.append(np.array([g.obs_sigma.get(name, cfg.gcp_obs_sigma_px)]))
             s = (
                 g.sigma
                 if g.sigma is not None

@@ -114,3 +114,42 @@ def test_mapping_names_must_be_in_the_gcp_layer(truortho_provider, folder, tmp_p
     res = run({"IMAGES": str(root), "MARKER_IDS": "0=G0", "GCPS": layer, "OUTPUT": str(out)})
     _, rows = _rows(res["OUTPUT"])
     assert {r["gcp"] for r in rows} == {"G0"} and len(rows) == 3
+
+
+def test_table_sigmas_become_measurement_weights(truortho_provider, folder, tmp_path):
+    """The table's sigma_x/sigma_y reach GCP.obs_sigma (the bundle weights); a bad sigma is named."""
+    from qgis.core import QgsFeature, QgsField, QgsProcessingException, QgsVectorLayer
+    from qgis.PyQt.QtCore import QVariant
+
+    from truortho.core.orientation import GCP
+    from truortho.processing.layers import read_observation_table
+
+    root, _ = folder
+    res = run({"IMAGES": str(root), "MARKER_IDS": "0=G0", "OUTPUT": str(tmp_path / "obs.gpkg")})
+    table = QgsVectorLayer(res["OUTPUT"], "obs", "ogr")
+    gcps = [GCP("G0", [0.0, 0.0, 0.0])]
+    read_observation_table(table, gcps)
+    assert len(gcps[0].observations) == 3
+    for f in table.getFeatures():
+        expected = np.sqrt((f["sigma_x"] ** 2 + f["sigma_y"] ** 2) / 2)
+        assert gcps[0].obs_sigma[f["image"]] == pytest.approx(expected)
+
+    mem = QgsVectorLayer("None", "obs", "memory")
+    mem.dataProvider().addAttributes(
+        [QgsField(n, QVariant.String) for n in ("gcp", "image")]
+        + [QgsField(n, QVariant.Double) for n in ("x", "y", "sigma")]
+    )
+    mem.updateFields()
+    rows = [("G0", "a.png", 1.0, 2.0, None), ("G0", "b.png", 3.0, 4.0, 0.25)]
+    for r in rows:
+        f = QgsFeature(mem.fields())
+        f.setAttributes(list(r))
+        mem.dataProvider().addFeatures([f])
+    gcps = [GCP("G0", [0.0, 0.0, 0.0])]
+    read_observation_table(mem, gcps)
+    assert gcps[0].obs_sigma == {"b.png": 0.25}  # an empty sigma keeps the default
+    f = QgsFeature(mem.fields())
+    f.setAttributes(["G0", "c.png", 1.0, 1.0, -1.0])
+    mem.dataProvider().addFeatures([f])
+    with pytest.raises(QgsProcessingException, match="sigma must be positive"):
+        read_observation_table(mem, [GCP("G0", [0.0, 0.0, 0.0])])

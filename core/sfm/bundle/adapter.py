@@ -31,7 +31,8 @@ class OrientationBundleConfig:
     fixed_images : collection of str
         Names of images whose pose is held.
     obs_sigma : float
-        Standard deviation of tie-point and GCP image measurements, pixels.
+        Standard deviation of tie-point and GCP image measurements, pixels (a GCP measurement
+        with its own sigma in ``GCP.obs_sigma`` uses that).
     use_gcps : bool
         GCPs with role "gcp" and image measurements become control points
         (prior = their coordinates, sigma = their ``sigma`` or
@@ -76,6 +77,7 @@ def adjust_orientation(
     pts = orientation.points or SparsePoints(np.zeros((0, 3)))
     xyz = [pts.xyz]
     o_img, o_pt, o_xy = [pts.obs_image], [pts.obs_point], [pts.obs_xy]
+    o_sig = [np.full(len(pts.obs_image), float(cfg.obs_sigma))]
     pri_idx, pri_xyz, pri_sig = [], [], []
     n = len(pts.xyz)
     if cfg.use_gcps:
@@ -87,6 +89,9 @@ def adjust_orientation(
             o_img.append(np.array([names[i] for i, _, _ in g.observations], dtype=np.int64))
             o_pt.append(np.full(len(g.observations), n, dtype=np.int64))
             o_xy.append(np.array([[x, y] for _, x, y in g.observations], dtype=np.float64))
+            o_sig.append(
+                np.array([g.obs_sigma.get(i, cfg.obs_sigma) for i, _, _ in g.observations], dtype=float)
+            )
             if g.role == "gcp":
                 pri_idx.append(n)
                 pri_xyz.append(local)
@@ -121,7 +126,7 @@ def adjust_orientation(
         obs_image=obs_image,
         obs_point=np.concatenate(o_pt),
         obs_xy=np.concatenate(o_xy).reshape(-1, 2),
-        obs_sigma=np.full(len(obs_image), float(cfg.obs_sigma)),
+        obs_sigma=np.concatenate(o_sig),
         refine_intrinsics=refine,
         fixed_images=fixed,
         point_prior_index=np.array(pri_idx, dtype=np.int64),
