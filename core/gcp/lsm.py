@@ -278,8 +278,21 @@ def _reach(template_shape, p) -> float:
     return float(np.abs(a).sum(axis=1).max() * max(hu, hv) * (1.0 + 4.0 * (abs(p[4]) * hu + abs(p[5]) * hv)))
 
 
+def _image(a, what: str) -> np.ndarray:
+    """A search image as given (any real dtype): checked for shape only; windows are converted
+    to float64 and checked for NaN when they are cut (:func:`_crop`), so a large image is
+    neither copied nor scanned for every match."""
+    arr = np.asarray(a)
+    if arr.ndim != 2 or min(arr.shape) < 3 or not np.issubdtype(arr.dtype, np.number):
+        raise InputError(f"{what}: expected a 2-D grey image of at least 3x3 pixels, got shape {arr.shape}")
+    return arr
+
+
 def _crop(image: np.ndarray, cx: float, cy: float, radius: float):
-    """Window of ``image`` around (cx, cy) of the given radius: (window, x offset, y offset)."""
+    """Window of ``image`` around (cx, cy) of the given radius: (window, x offset, y offset).
+
+    Raises InputError when the window holds NaN or infinite values.
+    """
     h, w = image.shape
     r = int(math.ceil(radius)) + 2
     x0 = max(0, int(math.floor(cx)) - r)
@@ -288,7 +301,10 @@ def _crop(image: np.ndarray, cx: float, cy: float, radius: float):
     y1 = min(h, int(math.floor(cy)) + r + 2)
     if x1 - x0 < 3 or y1 - y0 < 3:
         return None, x0, y0
-    return np.ascontiguousarray(image[y0:y1, x0:x1], dtype=np.float64), x0, y0
+    win = np.ascontiguousarray(image[y0:y1, x0:x1], dtype=np.float64)
+    if not np.all(np.isfinite(win)):
+        raise InputError(f"image: NaN or infinite values near ({cx:.1f}, {cy:.1f})")
+    return win, x0, y0
 
 
 def _ncc(a: np.ndarray, b: np.ndarray) -> float:
@@ -455,7 +471,7 @@ def lsm_match(
     """
     cfg = config or LsmConfig()
     t = _check_template(template)
-    img = _gray(image, "image")
+    img = _image(image, "image")
     if not (math.isfinite(x) and math.isfinite(y)):
         raise InputError(f"lsm_match: start position must be finite, got ({x}, {y})")
     p = _initial_params(float(x), float(y), initial)
@@ -519,13 +535,20 @@ def extract_template(image, x: float, y: float, half_size: int) -> np.ndarray:
     InputError
         When the patch does not lie inside the image.
     """
-    img = _gray(image, "image")
+    img = _image(image, "image")
     if not (isinstance(half_size, int | np.integer) and half_size >= 1):
         raise InputError(f"half_size must be a positive integer, got {half_size!r}")
     n = 2 * int(half_size) + 1
     p = _initial_params(float(x), float(y), None)
-    out = np.zeros((n, n))
-    _normals(np.zeros((n, n)), img, img, img, p, 0.0, 1.0, np.zeros((10, 10)), np.zeros(10), out)
+    out = np.full((n, n), np.nan)
+    if math.isfinite(x) and math.isfinite(y):
+        window, ox, oy = _crop(img, x, y, half_size + 2)
+        if window is not None:
+            p[8] -= ox
+            p[9] -= oy
+            _normals(
+                np.zeros((n, n)), window, window, window, p, 0.0, 1.0, np.zeros((10, 10)), np.zeros(10), out
+            )
     if not np.all(np.isfinite(out)):
         raise InputError(
             f"template at ({x:.1f}, {y:.1f}) with half size {half_size} reaches outside the image"
@@ -645,7 +668,7 @@ def mgcm(
     views = list(views)
     if len(views) < 2:
         raise InputError(f"mgcm: needs at least two views, got {len(views)}")
-    imgs = [_gray(v.image, f"view {v.name or i!r} image") for i, v in enumerate(views)]
+    imgs = [_image(v.image, f"view {v.name or i!r} image") for i, v in enumerate(views)]
     local = _PROJECTIVE_LOCAL if cfg.projective else _AFFINE_LOCAL
     k = len(local)
     nv = len(views)
