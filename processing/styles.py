@@ -13,6 +13,7 @@ pointer): they are kept in a module-level registry.
 from __future__ import annotations
 
 from qgis.core import (
+    QgsBilinearRasterResampler,
     QgsColorRampShader,
     QgsContrastEnhancement,
     QgsHillshadeRenderer,
@@ -45,6 +46,10 @@ def apply_style(layer, kind: str) -> bool:
         renderer = QgsHillshadeRenderer(provider, 1, 315.0, 45.0)
         renderer.setMultiDirectional(True)
         layer.setRenderer(renderer)
+        # zoomed in, shade the DSM's own cells and interpolate the shading: with the default
+        # nearest-neighbour resampling the renderer gets repeated rows and columns, whose zero
+        # gradients draw a grid of flat lines across the hillshade
+        layer.resampleFilter().setZoomedInResampler(QgsBilinearRasterResampler())
     elif kind == "ortho":
         if layer.bandCount() < 3:
             return False

@@ -37,7 +37,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--products", default=str(ROOT / "build" / "demo" / "products"))
     ap.add_argument("--output", default=str(OUT))
-    ap.add_argument("--width", type=int, default=1600, help="width of the picture, pixels")
+    ap.add_argument("--width", type=int, default=1400, help="width of the picture, pixels")
     args = ap.parse_args(argv)
     from PIL import Image
 
@@ -62,7 +62,7 @@ def main(argv=None) -> int:
     gap = np.full((rows, max(cols // 60, 4), 3), 255, np.uint8)
     both = np.concatenate([left[:rows, :cols], gap, right[:rows, :cols]], axis=1)
     img = Image.fromarray(both)
-    if img.width > args.width:
+    if img.width != args.width:  # the sample's products are small: enlarged for reading, or reduced
         img = img.resize((args.width, round(img.height * args.width / img.width)), Image.LANCZOS)
     out = Path(args.output)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -52,33 +52,35 @@ def pipeline_dialog(out: Path, products: Path | None) -> None:
     from qgis.gui import QgsMapCanvas
     from qgis.PyQt.QtWidgets import QMainWindow
 
-    try:  # pytest-qgis's stand-in for QGIS's main window interface (the dialog asks iface for a parent)
-        from pytest_qgis.mock_qgis_classes import MockMessageBar
-        from pytest_qgis.qgis_interface import QgisInterface
+    window = QMainWindow()
+    canvas = QgsMapCanvas(window)
 
-        window = QMainWindow()
-        qgis.utils.iface = QgisInterface(QgsMapCanvas(window), MockMessageBar(), window)
-    except ImportError:
-        pass
+    class _Iface:  # the little of QGIS's interface the Processing dialog asks for
+        def mainWindow(self):  # noqa: N802 - QGIS API
+            return window
+
+        def mapCanvas(self):  # noqa: N802 - QGIS API
+            return canvas
+
+        def messageBar(self):  # noqa: N802 - QGIS API
+            return None
+
+    qgis.utils.iface = _Iface()
     alg = QgsApplication.processingRegistry().createAlgorithmById("truortho:pipeline")
     dialog = AlgorithmDialog(alg)
     dialog.resize(900, 760)
-    panel = dialog.mainWidget()
     sample = ROOT / "sample" / "copr"
     values = {"IMAGES": str(sample / "images"), "RESOLUTION": 0.1}
     if products is not None:
         values["OUTPUT_FOLDER"] = str(products)
-    for name, value in values.items():
-        wrapper = panel.wrappers.get(name)
-        if wrapper is not None:
-            wrapper.setParameterValue(value, dialog.processingContext())
+    dialog.setParameters(values)
     dialog.show()
     QgsApplication.processEvents()
     dialog.grab().save(str(out))
     dialog.close()
 
 
-def demo_layers(out: Path, products: Path, size: tuple[int, int] = (1100, 900)) -> None:
+def demo_layers(out: Path, products: Path, size: tuple[int, int] = (1400, 0)) -> None:
     """The pipeline's layers as the plugin loads and styles them, rendered to a PNG."""
     from qgis.core import (
         QgsFillSymbol,
@@ -106,7 +108,8 @@ def demo_layers(out: Path, products: Path, size: tuple[int, int] = (1100, 900)) 
     seams.renderer().setSymbol(symbol)
     # left half: the true ortho with occlusion and seamlines; right half: the DSM hillshade
     ext = ortho.extent()
-    w, h = size
+    w = size[0]
+    h = max(1, round(w / 2 * ext.height() / max(ext.width(), 1e-9)))  # each half keeps the extent's shape
     images = []
     for layers in ([seams, occl, ortho], [dsm]):
         ms = QgsMapSettings()
