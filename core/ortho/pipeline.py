@@ -62,7 +62,7 @@ from .tiles import (
     tile_costs,
     waves,
 )
-from .views import HeightBlocks, prepare_views, tile_views
+from .views import HeightBlocks, ViewSetup, prepare_views, tile_views
 from .zbuffer import occluder_wall_min
 
 
@@ -310,6 +310,75 @@ def _bounded_tiles(setup, grid, to_local, tile_size: int, overlap: int, bands: i
         size //= 2
 
 
+@dataclass(frozen=True)
+class OrthoPlan:
+    """Stage 1 of :func:`true_ortho`: the checked inputs and the output grid.
+
+    ``to_local`` maps output-CRS plan coordinates to the orientation's local frame; ``grid``
+    is the output raster (cell size ``res`` in output CRS units).
+    """
+
+    orientation: Orientation
+    surface: object
+    out_crs: str | None
+    to_local: PlanTransform
+    grid: RasterGrid
+    res: float
+
+
+@dataclass(frozen=True)
+class OrthoCandidates:
+    """Stage 2: the per-image visibility setup and the images that can texture the grid.
+
+    ``relevant`` (K,) indices of the images whose footprint meets the extent (the others'
+    boxes are NaN in ``setup``); ``paths`` and ``sizes`` (width, height) of every image;
+    ``bands``/``dtype`` shared by the relevant images; ``store`` their decoded-image cache.
+    """
+
+    setup: ViewSetup
+    relevant: np.ndarray
+    paths: list[str]
+    sizes: list[tuple[int, int]]
+    bands: int
+    dtype: np.dtype
+    store: ImageStore
+
+
+@dataclass(frozen=True)
+class OrthoSchedule:
+    """Stage 3: the tiles, in waves cut into batches (the costliest of a wave first).
+
+    ``k_max`` is the most candidate images of a tile and ``memory`` the bytes one tile task
+    may take (:func:`~.tiles.task_memory`), given to the executor.
+    """
+
+    overlap: int
+    tile_size: int
+    tiles: list
+    batches: list[list]
+    k_max: int
+    memory: int
+
+
+@dataclass(frozen=True)
+class OrthoMosaic:
+    """Stage 4: what running the tiles wrote and counted (the rasters are closed).
+
+    ``counts`` (N,) cells taken from every image; the ``n_*`` counters are cells of the grid;
+    ``stats`` the run's entries of :attr:`TrueOrthoResult.stats` (colour, executor, memory, times).
+    """
+
+    correction: ColorCorrection | None
+    regions: list[SeamRegion]
+    counts: np.ndarray
+    n_valid: int
+    n_seen: int
+    n_occluded: int
+    n_samples: int
+    max_triangles: int
+    stats: dict
+
+
 def true_ortho(
     orientation,
     surface,
@@ -322,6 +391,10 @@ def true_ortho(
     executor=None,
 ) -> TrueOrthoResult:
     """Compute a true orthophoto.
+
+    The stages: :func:`plan_ortho` (inputs, grid) -> :func:`ortho_candidates` (visibility setup,
+    images) -> :func:`schedule_tiles` -> :func:`run_mosaic` (colour correction, tiles, rasters,
+    seamlines) -> the result and its statistics.
 
     Parameters
     ----------
@@ -359,7 +432,75 @@ def true_ortho(
         # a malformed EXECUTOR / SCHEDULER_ADDRESS fails here, before any work (nothing connects yet)
         make_executor(cfg.executor, cfg.scheduler_address, n_workers=cfg.dask_workers).close()
     steps = Steps(progress, [1, 3 if cfg.color_correction else 0, 12, 1])
-    prog = as_progress(progress)
+    plan = plan_ortho(orientation, surface, cfg, source_index)
+    cand = ortho_candidates(plan, cfg, image_root, progress)
+    grid = plan.grid
+    steps[0].update(
+        1.0, f"true ortho: {grid.rows} x {grid.cols} cells of {plan.res:g}, {len(cand.relevant)} images"
+    )
+    stats: dict = {
+        "rows": grid.rows,
+        "cols": grid.cols,
+        "resolution": plan.res,
+        "crs": plan.out_crs,
+        "images_relevant": int(len(cand.relevant)),
+        "bands": cand.bands,
+        "dtype": cand.dtype.name,
+        "visibility": cfg.visibility,
+        "margin_cells": cand.setup.margin_cells,
+        "reprojected": not plan.to_local.identity,
+    }
+    sched = schedule_tiles(plan, cand, cfg)
+    stats["tile_size"] = sched.tile_size
+    mosaic = run_mosaic(plan, cand, sched, cfg, output, source_index, occlusion, steps, progress, executor)
+    stats.update(mosaic.stats)
+    stats.update(
+        {
+            "tiles": len(sched.tiles),
+            "cells": grid.rows * grid.cols,
+            "cells_with_surface": mosaic.n_valid,
+            "cells_textured": mosaic.n_seen,
+            "cells_occluded": mosaic.n_occluded,
+            "coverage": round(mosaic.n_seen / mosaic.n_valid, 6) if mosaic.n_valid else 0.0,
+            "images_used": int(np.count_nonzero(mosaic.counts)),
+            "image_reads": cand.store.reads,
+            "image_window_reads": cand.store.window_reads,
+            "max_triangles_per_tile": int(mosaic.max_triangles),
+            "cell_image_samples": mosaic.n_samples,
+            "seconds_total": round(time.perf_counter() - t_start, 3),
+        }
+    )
+    steps[3].update(1.0, "true orthophoto written")
+    as_progress(progress).update(1.0, None)
+    return TrueOrthoResult(
+        Path(os.fspath(output)),
+        Path(source_index) if source_index else None,
+        Path(occlusion) if occlusion else None,
+        grid,
+        mosaic.regions,
+        mosaic.correction,
+        stats,
+    )
+
+
+def plan_ortho(orientation, surface, cfg: TrueOrthoConfig, source_index=None) -> OrthoPlan:
+    """Check the orientation, the surface and the CRSs; the output grid (stage 1 of :func:`true_ortho`).
+
+    Parameters
+    ----------
+    orientation : Orientation or path
+    surface : path or surface object (see :func:`true_ortho`)
+    cfg : TrueOrthoConfig
+        Validated; ``resolution``, ``extent`` and ``crs`` are used here.
+    source_index : path, optional
+        Only checked: an int16 index holds at most 32767 images.
+
+    Raises
+    ------
+    InputError, CRSError
+        No image, an orientation without CRS for a georeferenced surface, a non-metric CRS, an
+        extent the surface does not cover, no transformation between the CRSs.
+    """
     o = as_orientation(orientation)
     if not o.images:
         raise InputError("ORIENTATION: the orientation holds no image")
@@ -382,7 +523,6 @@ def true_ortho(
 
         parse_crs(out_crs)
     to_local = PlanTransform(out_crs, o_crs, o.offset)
-    # ---- grid and coverage of the surface
     s_bounds = transform_bounds(surf.bounds, surf.crs or out_crs, out_crs)
     res = float(cfg.resolution) if cfg.resolution else _default_resolution(surf, o, out_crs)
     extent = tuple(float(v) for v in (cfg.extent or s_bounds))
@@ -406,14 +546,32 @@ def true_ortho(
     to_local.xy(
         np.array([gx0, gx1, gx0, gx1, 0.5 * (gx0 + gx1)]), np.array([gy0, gy0, gy1, gy1, 0.5 * (gy0 + gy1)])
     )
+    return OrthoPlan(o, surf, out_crs, to_local, grid, res)
+
+
+def ortho_candidates(
+    plan: OrthoPlan, cfg: TrueOrthoConfig, image_root=None, progress=None
+) -> OrthoCandidates:
+    """The visibility setup and the images that can contribute (stage 2 of :func:`true_ortho`).
+
+    Only images whose footprint box meets the extent stay candidates; they must exist on disk,
+    share one band count and dtype, match their camera's size and suit the compression.
+
+    Raises
+    ------
+    InputError, MissingFileError
+    """
+    o, surf, grid, to_local = plan.orientation, plan.surface, plan.grid, plan.to_local
     wall_min = (
-        cfg.wall_min if cfg.wall_min is not None else occluder_wall_min(res, math.radians(cfg.max_view_angle))
+        cfg.wall_min
+        if cfg.wall_min is not None
+        else occluder_wall_min(plan.res, math.radians(cfg.max_view_angle))
     )
     setup = prepare_views(
         o,
         surf,
         to_local,
-        res,
+        plan.res,
         cfg.max_view_angle,
         cfg.visibility,
         cfg.depth_tolerance,
@@ -426,7 +584,7 @@ def true_ortho(
     )
     if cfg.visibility and setup.margin_cells > 0:
         setup.blocks = HeightBlocks.of(surf, grid, progress=progress)
-    # ---- images that can contribute: on disk, one band count and dtype
+    gx0, gy0, gx1, gy1 = grid.extent
     ex_x, ex_y = to_local.xy(np.array([gx0, gx1, gx0, gx1]), np.array([gy0, gy0, gy1, gy1]))
     b = setup.boxes
     with np.errstate(invalid="ignore"):
@@ -473,27 +631,71 @@ def true_ortho(
             raise InputError("compression: this GDAL cannot write ZSTD; use 'deflate' or 'lzw'")
     sizes = [(c.width, c.height) for c in setup.cameras]
     store = ImageStore(paths, sizes, bands, dtype, cfg.image_cache_mb << 20)
+    return OrthoCandidates(setup, relevant, paths, sizes, bands, dtype, store)
+
+
+def schedule_tiles(plan: OrthoPlan, cand: OrthoCandidates, cfg: TrueOrthoConfig) -> OrthoSchedule:
+    """Tiles within the memory budget, in waves and batches (stage 3 of :func:`true_ortho`).
+
+    Tiles of a wave do not touch each other; a wave runs in batches of at most ~256 MiB of
+    results (the client's memory stays bounded), the costliest tiles first (results do not
+    depend on the order).
+    """
+    grid, setup, bands, dtype = plan.grid, cand.setup, cand.bands, cand.dtype
+    overlap = max(cfg.blend_width, 4) + 8
+    tile_size, tiles, k_tile = _bounded_tiles(setup, grid, plan.to_local, cfg.tile_size, overlap, bands)
+    k_max = int(max(1, k_tile.max()))
+    cost = dict(zip((t.index for t in tiles), tile_costs(setup, grid, tiles, k_tile), strict=True))
+    per_tile = (tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
+    batch_tiles = max(1, (256 << 20) // per_tile)
+    ordered = [sorted(w, key=lambda t: (-cost[t.index], t.index)) for w in waves(tiles)]
+    batches = [w[i : i + batch_tiles] for w in ordered for i in range(0, len(w), batch_tiles)]
+    img_bytes = (
+        max(w * h for w, h in (cand.sizes[i] for i in cand.relevant)) * bands * dtype.itemsize * 4 // 3
+    )
+    memory = task_memory(
+        side_of(tile_size, overlap),
+        setup.margin_cells,
+        k_max,
+        bands,
+        min(cfg.image_cache_mb << 20, k_max * img_bytes),
+    )
+    return OrthoSchedule(overlap, tile_size, tiles, batches, k_max, memory)
+
+
+def run_mosaic(
+    plan: OrthoPlan,
+    cand: OrthoCandidates,
+    sched: OrthoSchedule,
+    cfg: TrueOrthoConfig,
+    output,
+    source_index,
+    occlusion,
+    steps: Steps,
+    progress: Progress | None,
+    executor,
+) -> OrthoMosaic:
+    """Colour correction, the tiles on the executor, the rasters and the seamlines (stage 4).
+
+    ``steps`` are :func:`true_ortho`'s four progress steps (the colour correction reports on the
+    second, the tiles on the third, the overviews on the fourth). The rasters are written by
+    windows and closed (overviews, COG copies) before this returns.
+    """
+    o, surf, grid, to_local = plan.orientation, plan.surface, plan.grid, plan.to_local
+    setup, paths, sizes, bands, dtype, store = (
+        cand.setup,
+        cand.paths,
+        cand.sizes,
+        cand.bands,
+        cand.dtype,
+        cand.store,
+    )
+    tiles, batches = sched.tiles, sched.batches
     params = MosaicParams(
         cfg.edge_penalty, cfg.smoothness, cfg.contrast, cfg.discontinuity, cfg.blend_width, cfg.sweeps
     )
     workers = max(1, int(cfg.workers))
-    steps[0].update(1.0, f"true ortho: {grid.rows} x {grid.cols} cells of {res:g}, {len(relevant)} images")
-    stats: dict = {
-        "rows": grid.rows,
-        "cols": grid.cols,
-        "resolution": res,
-        "crs": out_crs,
-        "images_relevant": int(len(relevant)),
-        "bands": bands,
-        "dtype": dtype.name,
-        "visibility": cfg.visibility,
-        "margin_cells": setup.margin_cells,
-        "reprojected": not to_local.identity,
-    }
-    # ---- tiles, in waves (the costliest of a wave first; results do not depend on the order)
-    overlap = max(cfg.blend_width, 4) + 8
-    tile_size, tiles, k_tile = _bounded_tiles(setup, grid, to_local, cfg.tile_size, overlap, bands)
-    stats["tile_size"] = tile_size
+    stats: dict = {}
     sub = steps[2]
     ctx = OrthoContext(
         setup,
@@ -510,13 +712,6 @@ def true_ortho(
         workers,
         store=store,
     )
-    k_max = int(max(1, k_tile.max()))
-    cost = dict(zip((t.index for t in tiles), tile_costs(setup, grid, tiles, k_tile), strict=True))
-    # a wave runs in batches of at most ~256 MiB of results, so the client's memory is bounded
-    per_tile = (tile_size**2) * ((bands + 1) * dtype.itemsize + 3) + 1
-    batch_tiles = max(1, (256 << 20) // per_tile)
-    ordered = [sorted(w, key=lambda t: (-cost[t.index], t.index)) for w in waves(tiles)]
-    batches = [w[i : i + batch_tiles] for w in ordered for i in range(0, len(w), batch_tiles)]
     in_process = isinstance(executor, InProcessExecutor) or (executor is None and cfg.executor == "inprocess")
     parts: dict[int, list] = {}
     counts = np.zeros(len(o.images), np.int64)
@@ -531,17 +726,17 @@ def true_ortho(
             ctx.prefetch = ViewPrefetch(ctx, limit=1)
             stack.callback(ctx.prefetch.close)
             ctx.prefetch.submit(batches[0])
-        # ---- colour correction
+        # colour correction
         correction = None
         t0 = time.perf_counter()
-        if cfg.color_correction and len(relevant) > 1:
+        if cfg.color_correction and len(cand.relevant) > 1:
             correction = _estimate_colour(
                 setup, surf, grid, to_local, store, cfg, steps[1], workers, len(o.images)
             )
             stats["color_correction"] = correction.as_dict([im.name for im in o.images])
         ctx.correction = correction
         stats["seconds_color"] = round(time.perf_counter() - t0, 3)
-        # ---- mosaic
+        # mosaic
         t0 = time.perf_counter()
         # scratch tiles beside the output: a rerun after a crash resumes from them
         executor, cache = stack.enter_context(
@@ -573,18 +768,10 @@ def true_ortho(
             cfg.jpeg_quality,
         )
         tri_max = 0
-        done = DoneLabels(overlap)  # border strips of the labels of finished tiles
-        img_bytes = max(w * h for w, h in (sizes[i] for i in relevant)) * bands * dtype.itemsize * 4 // 3
-        memory = task_memory(
-            side_of(tile_size, overlap),
-            setup.margin_cells,
-            k_max,
-            bands,
-            min(cfg.image_cache_mb << 20, k_max * img_bytes),
-        )
-        stats["max_candidates_per_tile"] = k_max
-        stats["task_memory_mb"] = round(memory / 2**20, 1)
-        base = _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs)
+        done = DoneLabels(sched.overlap)  # border strips of the labels of finished tiles
+        stats["max_candidates_per_tile"] = sched.k_max
+        stats["task_memory_mb"] = round(sched.memory / 2**20, 1)
+        base = _cache_base(o, paths, cand.relevant, surf, cfg, correction, grid, plan.out_crs)
         n_done = 0
         for bi, wave in enumerate(batches):
             check(progress)
@@ -603,7 +790,7 @@ def true_ortho(
                     cache=cache,
                     key=lambda t: t.key(base),
                     label="true ortho",
-                    memory=memory,
+                    memory=sched.memory,
                 )
             except CancelledError:
                 raise CancelledError("true orthophoto cancelled") from None
@@ -642,33 +829,7 @@ def true_ortho(
     stats["seconds_mosaic"] = round(time.perf_counter() - t0, 3)
     stats["tile_cache"] = {"hits": cache.hits, "written": cache.written}
     regions = [SeamRegion(k, o.images[k].name, int(counts[k]), g) for k, g in dissolved.items()]
-    stats.update(
-        {
-            "tiles": len(tiles),
-            "cells": grid.rows * grid.cols,
-            "cells_with_surface": n_valid,
-            "cells_textured": n_seen,
-            "cells_occluded": n_occl,
-            "coverage": round(n_seen / n_valid, 6) if n_valid else 0.0,
-            "images_used": int(np.count_nonzero(counts)),
-            "image_reads": store.reads,
-            "image_window_reads": store.window_reads,
-            "max_triangles_per_tile": int(tri_max),
-            "cell_image_samples": n_samples,
-            "seconds_total": round(time.perf_counter() - t_start, 3),
-        }
-    )
-    steps[3].update(1.0, "true orthophoto written")
-    prog.update(1.0, None)
-    return TrueOrthoResult(
-        out_path,
-        Path(source_index) if source_index else None,
-        Path(occlusion) if occlusion else None,
-        grid,
-        regions,
-        correction,
-        stats,
-    )
+    return OrthoMosaic(correction, regions, counts, n_valid, n_seen, n_occl, n_samples, tri_max, stats)
 
 
 #: Config fields that do not change the mosaic (left out of the tile cache keys).
