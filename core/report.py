@@ -159,6 +159,7 @@ def pipeline_report(
     ortho_path,
     tres,
     reused: bool,
+    confidence_path=None,
 ) -> Report:
     """The whole chain's report (:func:`truortho.core.workflow.run_workflow`), but its stage table.
 
@@ -178,6 +179,8 @@ def pipeline_report(
         The true orthophoto's result (``stats``: coverage, occluded cells, size).
     reused : bool
         The orientation was read from an existing file.
+    confidence_path : path, optional
+        OSGM's confidence raster, for its histogram.
 
     Returns
     -------
@@ -232,8 +235,12 @@ def pipeline_report(
     ax.imshow(np.where(np.isfinite(dsm), shade, np.nan), cmap="gray", extent=ext)
     im = ax.imshow(np.where(np.isfinite(dsm), dsm, np.nan), cmap="terrain", alpha=0.45, extent=ext)
     fig.colorbar(im, ax=ax, label="height [m]")
+    ax.ticklabel_format(useOffset=False, style="plain")
     ax.set_title(f"Filtered DSM ({100 * filtered_share:.1f} % of the cells)")
     report.add_figure("DSM hillshade (filtered DSM)", fig)
+    _overlap_figure(report, plt, orientation, dsm_path)
+    if confidence_path is not None:
+        _confidence_figure(report, plt, confidence_path)
     # true ortho preview
     ortho, og, _ = read_preview(ortho_path, 1200, band=None)
     o = np.moveaxis(ortho, 0, -1)
@@ -248,10 +255,71 @@ def pipeline_report(
         show = o[:, :, 0]
     oext = (og.extent[0], og.extent[2], og.extent[1], og.extent[3])
     ax.imshow(show, extent=oext)
+    ax.ticklabel_format(useOffset=False, style="plain")
     ax.set_title(f"True orthophoto (black: seen by no image, {100 * occl:.2f} %)")
     report.add_figure("True orthophoto preview", fig)
     report.tables.append(Table(_CHAIN_TABLES[1], ["stage", "time [s]", "peak memory [MB]", "result"], []))
     return report
+
+
+def photo_counts(orientation, dsm, grid) -> np.ndarray:
+    """How many photos see each cell of ``dsm`` (on ``grid``, world heights; NaN cells at the median
+    height): the cell's surface point in front of the camera and inside the frame. Occlusion is not
+    tested (this is the coverage of the flight, not of the true orthophoto)."""
+    from .geometry import project_points
+
+    X, Y = grid.centres()
+    z = np.where(np.isfinite(dsm), dsm, np.nanmedian(dsm) if np.isfinite(dsm).any() else 0.0)
+    off = np.asarray(orientation.offset, np.float64)
+    P = np.column_stack([X.ravel() - off[0], Y.ravel() - off[1], z.ravel() - off[2]])
+    count = np.zeros(len(P), np.int32)
+    for im in orientation.images:
+        cam = orientation.camera_of(im)
+        uv, depth = project_points(P, im.R, im.C, cam, return_depth=True)
+        u, v = uv[:, 0], uv[:, 1]
+        with np.errstate(invalid="ignore"):  # NaN: behind the camera
+            count += (
+                (depth > 0) & (u >= -0.5) & (v >= -0.5) & (u <= cam.width - 0.5) & (v <= cam.height - 0.5)
+            )
+    return count.reshape(grid.shape)
+
+
+def _overlap_figure(report: Report, plt, orientation, dsm_path) -> None:
+    """Coverage and overlap: photos per DSM cell on a preview of at most 300 cells a side."""
+    from .rasterio_io import read_preview
+
+    dsm, grid, _ = read_preview(dsm_path, 300)
+    count = photo_counts(orientation, dsm, grid)
+    fig, ax = plt.subplots(figsize=(7, 6))
+    top = max(int(count.max()), 1)
+    cmap = plt.get_cmap("viridis", top + 1)
+    ext = (grid.extent[0], grid.extent[2], grid.extent[1], grid.extent[3])
+    im = ax.imshow(np.where(count > 0, count, np.nan), cmap=cmap, vmin=-0.5, vmax=top + 0.5, extent=ext)
+    fig.colorbar(im, ax=ax, label="photos that see the cell", ticks=range(0, top + 1, max(1, top // 10)))
+    inside = np.isfinite(dsm)
+    low = float((count[inside] < 2).mean()) if inside.any() else 0.0
+    ax.ticklabel_format(useOffset=False, style="plain")
+    ax.set_title(f"{100 * low:.1f} % of the DSM's cells are seen by fewer than 2 photos", fontsize=10)
+    report.add_figure("Coverage and overlap (photos per cell)", fig)
+    report.data["coverage"] = {
+        "photos_per_cell_histogram": np.bincount(count[inside].ravel(), minlength=top + 1).tolist(),
+        "share_below_2": low,
+    }
+
+
+def _confidence_figure(report: Report, plt, confidence_path) -> None:
+    """Histogram of OSGM's matching confidence (0 to 1) over the cells it matched."""
+    from .rasterio_io import read_preview
+
+    conf, _, _ = read_preview(confidence_path, 1200)
+    values = conf[np.isfinite(conf) & (conf >= 0)]
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    ax.hist(values, bins=40, range=(0, 1), color="#4477aa")
+    ax.set_xlabel("matching confidence (1 - best / second-best cost)")
+    ax.set_ylabel("cells")
+    med = float(np.median(values)) if len(values) else float("nan")
+    ax.set_title(f"DSM confidence: median {med:.2f} over {len(values)} cells (preview)")
+    report.add_figure("DSM confidence histogram", fig)
 
 
 def _fmt(v) -> str:

@@ -277,7 +277,7 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
     stages.start("report")
     report = pipeline_report(
         "TruOrtho pipeline report", orient_report, orientation, osgm, fstats, paths["dsm"],
-        paths["trueortho"], tres, reuse,
+        paths["trueortho"], tres, reuse, paths["confidence"],
     )  # fmt: skip
     ran_on = executor.describe() if hasattr(executor, "describe") else type(executor).__name__
     report.summary["tiles ran on"] = ran_on

@@ -45,3 +45,27 @@ def test_reused_orientation_report_keeps_the_orientation_part(tmp_path):
     assert reused_orientation_report(tmp_path / "missing.json") is None
     (tmp_path / "bad.json").write_text("{not json", encoding="utf-8")
     assert reused_orientation_report(tmp_path / "bad.json") is None
+
+
+def test_photo_counts_is_the_frame_test_of_every_photo():
+    """The report's coverage map counts, per cell, the photos whose frame holds the cell's surface
+    point (in front of the camera); the synthetic truth with occlusion switched off agrees exactly."""
+    import numpy as np
+
+    from truortho.core.grid import RasterGrid
+    from truortho.core.report import photo_counts
+    from truortho.core.synthetic import SceneConfig, make_scene
+
+    scene = make_scene(SceneConfig(image_size=(160, 120), focal_px=200.0, n_oblique=2, seed=4))
+    ext = scene.extent_world()
+    grid = RasterGrid.from_extent(ext, 2.0, scene.orientation.crs)
+    X, Y = grid.centres()
+    Pw = np.column_stack([X.ravel(), Y.ravel(), np.zeros(X.size)])
+    z = scene.height(Pw[:, :2]).reshape(grid.shape)
+    Pw[:, 2] = z.ravel()
+    truth = sum(
+        scene.visibility(Pw, i, tol=1e9)[0].astype(int) for i in range(len(scene.orientation.images))
+    ).reshape(grid.shape)
+    got = photo_counts(scene.orientation, z.astype(np.float32), grid)
+    assert got.shape == grid.shape and got.max() >= 4
+    assert (got == truth).mean() > 0.999  # a cell centre exactly on a frame border may go either way
