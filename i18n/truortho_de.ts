@@ -296,7 +296,7 @@
         <message>
             <location filename="../processing/algorithms/environment.py" line="99" />
             <source>Reports the versions of QGIS, GDAL, rasterio, numpy, numba, OpenCV and pyproj that TruOrtho runs with, and writes them to a JSON file. Fails if rasterio is linked to a different GDAL than QGIS. Also reports TruOrtho's cache folder (compiled kernels and image features; the environment variable TRUORTHO_CACHE_DIR moves it, default the per-user cache folder of the system) and its size; CLEAR_CACHE empties it.</source>
-            <translation type="unfinished" />
+            <translation>Meldet die Versionen von QGIS, GDAL, rasterio, numpy, numba, OpenCV und pyproj, mit denen TruOrtho läuft, und schreibt sie in eine JSON-Datei. Schlägt fehl, wenn rasterio gegen ein anderes GDAL als QGIS gelinkt ist. Meldet auch den Cache-Ordner von TruOrtho (kompilierte Kernel und Bildmerkmale; die Umgebungsvariable TRUORTHO_CACHE_DIR verlegt ihn, Vorgabe ist der benutzereigene Cache-Ordner des Systems) und seine Größe; CLEAR_CACHE leert ihn.</translation>
         </message>
         <message>
             <location filename="../processing/algorithms/environment.py" line="143" />
@@ -316,7 +316,7 @@
         <message>
             <location filename="../processing/algorithms/environment.py" line="119" />
             <source>Clear the cache (compiled kernels, image features)</source>
-            <translation type="unfinished" />
+            <translation>Cache leeren (kompilierte Kernel, Bildmerkmale)</translation>
         </message>
         <message>
             <location filename="../processing/algorithms/environment.py" line="124" />
@@ -326,7 +326,7 @@
         <message>
             <location filename="../processing/algorithms/environment.py" line="131" />
             <source>Cache cleared: {:.1f} MB freed</source>
-            <translation type="unfinished" />
+            <translation>Cache geleert: {:.1f} MB freigegeben</translation>
         </message>
         <message>
             <location filename="../processing/algorithms/environment.py" line="140" />
@@ -449,47 +449,47 @@
             <translation>Orientierung (JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="97" />
+            <location filename="../processing/algorithms/importorientation.py" line="99" />
             <source>Cameras</source>
             <translation>Kameras</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="101" />
+            <location filename="../processing/algorithms/importorientation.py" line="107" />
             <source>Footprints</source>
             <translation>Bildabdeckungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="127" />
+            <location filename="../processing/algorithms/importorientation.py" line="133" />
             <source>The orientation has no CRS: it stays in its arbitrary (local) frame. Give CRS (or a georef.json) to georeference it.</source>
             <translation>Die Orientierung hat kein KBS: sie bleibt in ihrem beliebigen (lokalen) System. Geben Sie CRS (oder eine georef.json) an, um sie zu georeferenzieren.</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="143" />
+            <location filename="../processing/algorithms/importorientation.py" line="149" />
             <source>OBSERVATIONS given without a GCPS layer</source>
             <translation>OBSERVATIONS ohne GCPS-Layer angegeben</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="117" />
+            <location filename="../processing/algorithms/importorientation.py" line="123" />
             <source>Read {} images, {} cameras, {} sparse points</source>
             <translation>{} Bilder, {} Kameras, {} Punkte der dünnen Punktwolke gelesen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="147" />
+            <location filename="../processing/algorithms/importorientation.py" line="153" />
             <source>GCPs need a georeferenced orientation: give CRS for the input</source>
             <translation>Passpunkte erfordern eine georeferenzierte Orientierung: geben Sie CRS für die Eingabe an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="124" />
+            <location filename="../processing/algorithms/importorientation.py" line="130" />
             <source>{}: the orientation contains no images</source>
             <translation>{}: die Orientierung enthält keine Bilder</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="153" />
+            <location filename="../processing/algorithms/importorientation.py" line="159" />
             <source>{} GCPs with {} image measurements</source>
             <translation>{} Passpunkte mit {} Bildmessungen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/importorientation.py" line="189" />
+            <location filename="../processing/algorithms/importorientation.py" line="194" />
             <source>Image {} does not see the plane at height {}</source>
             <translation>Bild {} sieht die Ebene in Höhe {} nicht</translation>
         </message>
@@ -599,82 +599,82 @@
             <translation>{} Zellen -&gt; {} Eckpunkte ({:.1%} der Zellen), {} Dreiecke, davon {} Wanddreiecke; Sprungschwelle {:.2f} m, Höhenfehler &lt;= {:.3f} m</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="54" />
+            <location filename="../processing/algorithms/orientimages.py" line="60" />
             <source>Orient images (bundle block adjustment)</source>
             <translation>Bilder orientieren (Bündelblockausgleichung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="87" />
+            <location filename="../processing/algorithms/orientimages.py" line="93" />
             <source>Image files (instead of a folder)</source>
             <translation>Bilddateien (statt eines Ordners)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="93" />
+            <location filename="../processing/algorithms/orientimages.py" line="99" />
             <source>Interior orientation file (optional)</source>
             <translation>Datei der inneren Orientierung (optional)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="96" />
+            <location filename="../processing/algorithms/orientimages.py" line="102" />
             <source>Output CRS</source>
             <translation>Ausgabe-KBS</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="100" />
+            <location filename="../processing/algorithms/orientimages.py" line="106" />
             <source>Working resolution (max image side, px)</source>
             <translation>Arbeitsauflösung (größte Bildseite, px)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="110" />
+            <location filename="../processing/algorithms/orientimages.py" line="116" />
             <source>Features per image</source>
             <translation>Merkmale pro Bild</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="119" />
+            <location filename="../processing/algorithms/orientimages.py" line="125" />
             <source>Self-calibration</source>
             <translation>Selbstkalibrierung</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="129" />
+            <location filename="../processing/algorithms/orientimages.py" line="137" />
             <source>Report (HTML)</source>
             <translation>Bericht (HTML)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="129" />
+            <location filename="../processing/algorithms/orientimages.py" line="138" />
             <source>HTML files (*.html)</source>
             <translation>HTML-Dateien (*.html)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="136" />
+            <location filename="../processing/algorithms/orientimages.py" line="154" />
             <source>Tie points</source>
             <translation>Verknüpfungspunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="142" />
+            <location filename="../processing/algorithms/orientimages.py" line="160" />
             <source>GCP and check point residuals</source>
             <translation>Residuen der Pass- und Kontrollpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="155" />
+            <location filename="../processing/algorithms/orientimages.py" line="173" />
             <source>Give either IMAGES (a folder) or IMAGE_FILES, not both</source>
             <translation>Geben Sie entweder IMAGES (einen Ordner) oder IMAGE_FILES an, nicht beides</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="165" />
+            <location filename="../processing/algorithms/orientimages.py" line="183" />
             <source>IMAGES: give an image folder or a list of image files</source>
             <translation>IMAGES: geben Sie einen Bildordner oder eine Liste von Bilddateien an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="206" />
+            <location filename="../processing/algorithms/orientimages.py" line="225" />
             <source>Registered {} of {} images; sigma0 {:.3f} px</source>
             <translation>{} von {} Bildern orientiert; Sigma0 {:.3f} px</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="179" />
+            <location filename="../processing/algorithms/orientimages.py" line="198" />
             <source>{} control and {} check points</source>
             <translation>{} Pass- und {} Kontrollpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/orientimages.py" line="158" />
+            <location filename="../processing/algorithms/orientimages.py" line="176" />
             <source>IMAGES: {} is not a folder</source>
             <translation>IMAGES: {} ist kein Ordner</translation>
         </message>
@@ -864,22 +864,22 @@
             <translation>RESOLUTION: positive Anzahl Meter oder 0 erwartet</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="173" />
+            <location filename="../processing/algorithms/pipeline.py" line="175" />
             <source>DSM (TruOrtho)</source>
             <translation>DOM (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="174" />
+            <location filename="../processing/algorithms/pipeline.py" line="176" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>True Orthophoto (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="175" />
+            <location filename="../processing/algorithms/pipeline.py" line="177" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Verdeckung (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="176" />
+            <location filename="../processing/algorithms/pipeline.py" line="178" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Nahtlinien (TruOrtho)</translation>
         </message>
@@ -1054,249 +1054,249 @@
             <translation>JPEG (verlustbehaftet, nur 8-Bit-RGB-Bilder; Alpha wird zur Maske)</translation>
         </message>
         <message>
-            <location filename="../processing/feedback.py" line="65" />
+            <location filename="../processing/feedback.py" line="86" />
             <source>Cancelled by the user</source>
             <translation>Vom Benutzer abgebrochen</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="14" />
+            <location filename="../processing/help/__init__.py" line="12" />
             <source>Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, or the path of a scheduler file; empty = the environment variable TRUORTHO_DASK_SCHEDULER. Security: a Dask scheduler executes any code its clients send, so it must never be reachable unauthenticated. Use TLS with certificates for a remote scheduler (configured in Dask's configuration, distributed.comm.tls), or an SSH tunnel to 127.0.0.1; a plain tcp:// address that is not on this computer is refused.</source>
             <translation>Adresse des Dask-Schedulers für EXECUTOR = scheduler: tls://host:8786 oder der Pfad einer Scheduler-Datei; leer = die Umgebungsvariable TRUORTHO_DASK_SCHEDULER. Sicherheit: Ein Dask-Scheduler führt jeden Code aus, den seine Clients senden, und darf daher nie ohne Authentifizierung erreichbar sein. Für einen entfernten Scheduler TLS mit Zertifikaten verwenden (in der Dask-Konfiguration, distributed.comm.tls) oder einen SSH-Tunnel nach 127.0.0.1; eine einfache tcp://-Adresse, die nicht auf diesem Rechner liegt, wird abgelehnt.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="26" />
+            <location filename="../processing/help/__init__.py" line="24" />
             <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
             <translation>Importiert die Orientierung eines Bildverbands (innere und äußere Orientierung jedes Bildes, dünne Punktwolke) aus COLMAP-, Orthority- oder OpenSfM/ODM-Dateien in das Orientierungs-JSON von TruOrtho und schreibt einen Layer der Projektionszentren und einen Layer der Bildabdeckungen. Konventionen (Kameraachsen, Rotationen, Pixelursprung) werden beim Import umgerechnet; siehe README, 'Formats and conventions'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="34" />
+            <location filename="../processing/help/__init__.py" line="32" />
             <source>COLMAP text model (cameras.txt, images.txt or points3D.txt; the folder is used, with an optional georef.json {"crs": ..., "offset": [E, N, H]}), Orthority exterior CSV (filename, x, y, z, omega, phi, kappa[, camera]; degrees), OpenSfM/ODM reconstruction.json, or a TruOrtho orientation JSON.</source>
             <translation>COLMAP-Textmodell (cameras.txt, images.txt oder points3D.txt; verwendet wird der Ordner, mit einer optionalen georef.json {"crs": ..., "offset": [E, N, H]}), Orthority-CSV der äußeren Orientierung (filename, x, y, z, omega, phi, kappa[, camera]; Grad), OpenSfM/ODM-reconstruction.json oder ein TruOrtho-Orientierungs-JSON.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="39" />
+            <location filename="../processing/help/__init__.py" line="37" />
             <source>Orthority interior parameter file (YAML or JSON); required with a CSV input.</source>
             <translation>Orthority-Parameterdatei der inneren Orientierung (YAML oder JSON); bei einer CSV-Eingabe erforderlich.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="40" />
+            <location filename="../processing/help/__init__.py" line="38" />
             <source>CRS of the input coordinates when the file does not state it (CSV without .prj, COLMAP without georef.json); target CRS for OpenSfM's topocentric frame.</source>
             <translation>KBS der Eingabekoordinaten, wenn die Datei es nicht angibt (CSV ohne .prj, COLMAP ohne georef.json); Ziel-KBS für das topozentrische System von OpenSfM.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="42" />
+            <location filename="../processing/help/__init__.py" line="40" />
             <source>Folder holding the images; every image of the block must be present there.</source>
             <translation>Ordner mit den Bildern; jedes Bild des Verbands muss dort vorhanden sein.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="43" />
+            <location filename="../processing/help/__init__.py" line="41" />
             <source>Optional ground control: point layer with 'name', 'role' (gcp|check), PointZ or a 'z' field, optional 'sigma_xy'/'sigma_z' in metres. Reprojected to the orientation's CRS.</source>
             <translation>Optionale Passpunkte: Punktlayer mit 'name', 'role' (gcp|check), PointZ oder einem Feld 'z', optional 'sigma_xy'/'sigma_z' in Metern. Wird in das KBS der Orientierung umprojiziert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="45" />
+            <location filename="../processing/help/__init__.py" line="43" />
             <source>Image measurements of the GCPs: table with 'gcp', 'image', 'x', 'y' in pixels ((0, 0) = centre of the top-left pixel).</source>
             <translation>Bildmessungen der Passpunkte: Tabelle mit 'gcp', 'image', 'x', 'y' in Pixeln ((0, 0) = Mitte des linken oberen Pixels).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="47" />
+            <location filename="../processing/help/__init__.py" line="45" />
             <source>Height (in the CRS) of the plane the footprints are drawn on; default the median height of the sparse points, or of the GCPs, or 0.</source>
             <translation>Höhe (im KBS) der Ebene, auf der die Bildabdeckungen gezeichnet werden; Standard ist die mittlere Höhe (Median) der dünnen Punktwolke, sonst der Passpunkte, sonst 0.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="49" />
+            <location filename="../processing/help/__init__.py" line="47" />
             <source>The orientation JSON (TruOrtho format, version 1).</source>
             <translation>Das Orientierungs-JSON (TruOrtho-Format, Version 1).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="50" />
-            <source>Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees).</source>
-            <translation>Projektionszentren als PointZ mit name, camera, x, y, z, omega, phi, kappa (Grad).</translation>
+            <location filename="../processing/help/__init__.py" line="48" />
+            <source>Optional: projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees); skipped when not given.</source>
+            <translation>Optional: Projektionszentren als PointZ mit name, camera, x, y, z, omega, phi, kappa (Grad); entfällt, wenn nicht angegeben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="52" />
+            <location filename="../processing/help/__init__.py" line="50" />
             <source>Image footprints on the horizontal plane at FOOTPRINT_HEIGHT.</source>
             <translation>Bildabdeckungen auf der horizontalen Ebene in Höhe FOOTPRINT_HEIGHT.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="57" />
+            <location filename="../processing/help/__init__.py" line="55" />
             <source>Exports a TruOrtho orientation JSON to a COLMAP text model (cameras.txt, images.txt, points3D.txt and georef.json) or to Orthority frame-camera files (exterior.csv with a .prj sidecar and interior.yaml).</source>
             <translation>Exportiert ein TruOrtho-Orientierungs-JSON in ein COLMAP-Textmodell (cameras.txt, images.txt, points3D.txt und georef.json) oder in Orthority-Dateien für Rahmenkameras (exterior.csv mit einer .prj-Begleitdatei und interior.yaml).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="62" />
+            <location filename="../processing/help/__init__.py" line="60" />
             <source>A TruOrtho orientation JSON.</source>
             <translation>Ein TruOrtho-Orientierungs-JSON.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="63" />
+            <location filename="../processing/help/__init__.py" line="61" />
             <source>colmap or opk (Orthority CSV + interior file).</source>
             <translation>colmap oder opk (Orthority-CSV + Datei der inneren Orientierung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="64" />
+            <location filename="../processing/help/__init__.py" line="62" />
             <source>Folder the files are written to (created if needed).</source>
             <translation>Ordner, in den die Dateien geschrieben werden (wird bei Bedarf angelegt).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="69" />
+            <location filename="../processing/help/__init__.py" line="67" />
             <source>Reads an ODM/OpenSfM gcp_list.txt (first line EPSG code, PROJ string or 'WGS84 UTM nnX'; then 'X Y Z px py image [name]') into a GCP point layer and an observation table, the two inputs ground control takes everywhere in TruOrtho.</source>
             <translation>Liest eine ODM/OpenSfM-gcp_list.txt (erste Zeile EPSG-Code, PROJ-String oder 'WGS84 UTM nnX'; dann 'X Y Z px py image [name]') in einen Passpunkt-Punktlayer und eine Beobachtungstabelle ein, die beiden Eingaben, die Passpunkte überall in TruOrtho benötigen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="74" />
+            <location filename="../processing/help/__init__.py" line="72" />
             <source>The gcp_list.txt file.</source>
             <translation>Die Datei gcp_list.txt.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="75" />
+            <location filename="../processing/help/__init__.py" line="73" />
             <source>Comma-separated GCP names to mark as check points (role 'check').</source>
             <translation>Kommagetrennte Passpunktnamen, die als Kontrollpunkte markiert werden (Rolle 'check').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="76" />
+            <location filename="../processing/help/__init__.py" line="74" />
             <source>Default planimetric standard deviation of the GCP coordinates, metres.</source>
             <translation>Standardabweichung der Lage der Passpunktkoordinaten (Standardwert), Meter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="77" />
+            <location filename="../processing/help/__init__.py" line="75" />
             <source>Default height standard deviation of the GCP coordinates, metres.</source>
             <translation>Standardabweichung der Höhe der Passpunktkoordinaten (Standardwert), Meter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="78" />
+            <location filename="../processing/help/__init__.py" line="76" />
             <source>Optional CRS to reproject the GCPs to (default: the file's CRS).</source>
             <translation>Optionales KBS, in das die Passpunkte umprojiziert werden (Standard: das KBS der Datei).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="79" />
+            <location filename="../processing/help/__init__.py" line="77" />
             <source>GCP point layer (PointZ): name, role, z, sigma_xy, sigma_z.</source>
             <translation>Passpunkt-Punktlayer (PointZ): name, role, z, sigma_xy, sigma_z.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="80" />
+            <location filename="../processing/help/__init__.py" line="78" />
             <source>Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the top-left pixel, as in gcp_list.txt).</source>
             <translation>Beobachtungstabelle: gcp, image, x, y (Pixel, (0, 0) = Mitte des linken oberen Pixels, wie in gcp_list.txt).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="86" />
+            <location filename="../processing/help/__init__.py" line="84" />
             <source>Finds ground targets in every photo of a folder and writes an observation table with a score per measurement. ArUco markers are found anywhere; the GCP is the marker's centre (intersection of the diagonals of its outer corners), refined by least-squares matching of the ideal marker. Circular and checkerboard (X) targets are searched near the positions an orientation predicts for the GCPs, then refined the same way. Measurements with a low score are kept and flagged, never dropped.</source>
             <translation>Findet Bodenmarken in jedem Foto eines Ordners und schreibt eine Beobachtungstabelle mit einer Bewertung je Messung. ArUco-Marker werden überall gefunden; der Passpunkt ist die Mitte des Markers (Schnittpunkt der Diagonalen seiner äußeren Ecken), verfeinert durch Kleinste-Quadrate-Zuordnung des idealen Markers. Kreisförmige und Schachbrettmarken (X) werden nahe den Positionen gesucht, die eine Orientierung für die Passpunkte vorhersagt, und ebenso verfeinert. Messungen mit niedriger Bewertung werden behalten und markiert, nie verworfen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="94" />
+            <location filename="../processing/help/__init__.py" line="92" />
             <source>Folder of the photos (jpg, png, tif, jp2, bmp).</source>
             <translation>Ordner der Fotos (jpg, png, tif, jp2, bmp).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="95" />
+            <location filename="../processing/help/__init__.py" line="93" />
             <source>ArUco markers, circular targets (a dark disc on a light ground or the reverse) or checkerboard targets (two dark and two light quadrants).</source>
             <translation>ArUco-Marker, kreisförmige Marken (eine dunkle Scheibe auf hellem Grund oder umgekehrt) oder Schachbrettmarken (zwei dunkle und zwei helle Quadranten).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="97" />
+            <location filename="../processing/help/__init__.py" line="95" />
             <source>The ArUco dictionary the markers were printed from.</source>
             <translation>Das ArUco-Wörterbuch, aus dem die Marker gedruckt wurden.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="98" />
+            <location filename="../processing/help/__init__.py" line="96" />
             <source>ArUco only: marker ID to GCP name, e.g. 0=GCP1,1=GCP2. With a GCP layer, every name must be in it.</source>
             <translation>Nur ArUco: Marker-ID zu Passpunktname, z. B. 0=GCP1,1=GCP2. Mit einem Passpunktlayer muss jeder Name darin vorkommen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="100" />
+            <location filename="../processing/help/__init__.py" line="98" />
             <source>Circular and checkerboard targets: the orientation (TruOrtho JSON) of the photos, used to predict where each GCP appears.</source>
             <translation>Kreisförmige und Schachbrettmarken: die Orientierung (TruOrtho-JSON) der Fotos, mit der vorhergesagt wird, wo jeder Passpunkt erscheint.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="102" />
+            <location filename="../processing/help/__init__.py" line="100" />
             <source>Point layer of the GCPs ('name' field; PointZ or a 'z' field) whose positions are predicted; for ArUco it only checks the names of MARKER_IDS.</source>
             <translation>Punktlayer der Passpunkte (Feld 'name'; PointZ oder ein Feld 'z'), deren Positionen vorhergesagt werden; bei ArUco prüft er nur die Namen von MARKER_IDS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="104" />
+            <location filename="../processing/help/__init__.py" line="102" />
             <source>Circular and checkerboard targets are searched this many pixels around their predicted positions.</source>
             <translation>Kreisförmige und Schachbrettmarken werden in diesem Abstand (Pixel) um ihre vorhergesagten Positionen gesucht.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="106" />
+            <location filename="../processing/help/__init__.py" line="104" />
             <source>Measurements scoring lower (normalised cross-correlation of the ideal target with the photo, 0 to 1) are flagged 'low score'.</source>
             <translation>Messungen mit niedrigerer Bewertung (normierte Kreuzkorrelation der idealen Marke mit dem Foto, 0 bis 1) werden als 'low score' markiert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="108" />
+            <location filename="../processing/help/__init__.py" line="106" />
             <source>Refine every centre by least-squares matching of the ideal target (gives the standard deviations).</source>
             <translation>Jede Mitte durch Kleinste-Quadrate-Zuordnung der idealen Marke verfeinern (liefert die Standardabweichungen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="110" />
+            <location filename="../processing/help/__init__.py" line="108" />
             <source>Observation table: gcp, image, x, y (pixels, (0, 0) = centre of the top-left pixel), score, sigma_x, sigma_y (pixels, empty when the refinement failed) and flag (ok, low score, refinement failed: reason).</source>
             <translation>Beobachtungstabelle: gcp, image, x, y (Pixel, (0, 0) = Mitte des Pixels oben links), score, sigma_x, sigma_y (Pixel, leer, wenn die Verfeinerung fehlschlug) und flag (ok, low score, refinement failed: Grund).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="117" />
+            <location filename="../processing/help/__init__.py" line="115" />
             <source>Orients a block of overlapping photos: SIFT features at a working resolution, pair selection (exhaustive for small blocks, EXIF GNSS footprints, or a low-resolution retrieval pass), robust two-view geometry, tie-point tracks decimated on a grid by multiplicity, incremental reconstruction and a bundle block adjustment written for TruOrtho (collinearity equations with Brown distortion, Levenberg-Marquardt with the Schur complement, Huber loss, self-calibration). Ground control fixes the datum (7-parameter similarity, then weighted GCP observations); check points never enter the adjustment and are reported with per-axis RMSE. Without GCPs, EXIF GNSS positions serve as weighted priors; without either the block stays in an arbitrary frame.</source>
             <translation>Orientiert einen Verband überlappender Fotos: SIFT-Merkmale in einer Arbeitsauflösung, Paarauswahl (vollständig bei kleinen Verbänden, über EXIF-GNSS-Bildabdeckungen oder einen Suchlauf in niedriger Auflösung), robuste Zweibildgeometrie, Verknüpfungspunktspuren, auf einem Raster nach Vielfachheit ausgedünnt, inkrementelle Rekonstruktion und eine für TruOrtho geschriebene Bündelblockausgleichung (Kollinearitätsgleichungen mit Brown-Verzeichnung, Levenberg-Marquardt mit dem Schur-Komplement, Huber-Verlustfunktion, Selbstkalibrierung). Passpunkte legen das Datum fest (7-Parameter-Ähnlichkeitstransformation, dann gewichtete Passpunktbeobachtungen); Kontrollpunkte gehen nie in die Ausgleichung ein und werden mit dem RMSE je Achse berichtet. Ohne Passpunkte dienen EXIF-GNSS-Positionen als gewichtete Vorinformation; ohne beides bleibt der Verband in einem beliebigen System.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="127" />
+            <location filename="../processing/help/__init__.py" line="125" />
             <source>Folder of the images (non-image files are skipped with a warning in the report).</source>
             <translation>Ordner der Bilder (Nicht-Bilddateien werden mit einer Warnung im Bericht übersprungen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="128" />
+            <location filename="../processing/help/__init__.py" line="126" />
             <source>The image files, instead of a folder.</source>
             <translation>Die Bilddateien, statt eines Ordners.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="129" />
+            <location filename="../processing/help/__init__.py" line="127" />
             <source>Interior orientation: an Orthority interior file (YAML/JSON) or a text file with the 3x3 matrix K, taken as a calibration and held fixed. Without it: EXIF focal length and sensor size, else f = 1.2 x max(w, h), refined by self-calibration.</source>
             <translation>Innere Orientierung: eine Orthority-Datei der inneren Orientierung (YAML/JSON) oder eine Textdatei mit der 3x3-Matrix K, als Kalibrierung übernommen und festgehalten. Ohne sie: EXIF-Brennweite und Sensorgröße, sonst f = 1,2 x max(w, h), verfeinert durch Selbstkalibrierung.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="132" />
+            <location filename="../processing/help/__init__.py" line="130" />
             <source>Ground control and check points: point layer with 'name', 'role' (gcp|check), PointZ or 'z', optional 'sigma_xy'/'sigma_z' (metres). Reprojected to CRS.</source>
             <translation>Pass- und Kontrollpunkte: Punktlayer mit 'name', 'role' (gcp|check), PointZ oder 'z', optional 'sigma_xy'/'sigma_z' (Meter). Wird in CRS umprojiziert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="134" />
+            <location filename="../processing/help/__init__.py" line="132" />
             <source>Image measurements of the GCPs: table with 'gcp', 'image' (file name), 'x', 'y' (pixels, (0, 0) = centre of the top-left pixel).</source>
             <translation>Bildmessungen der Passpunkte: Tabelle mit 'gcp', 'image' (Dateiname), 'x', 'y' (Pixel, (0, 0) = Mitte des linken oberen Pixels).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="136" />
+            <location filename="../processing/help/__init__.py" line="134" />
             <source>CRS of the output (default: the GCP layer's, else the UTM zone of the EXIF GNSS positions).</source>
             <translation>KBS der Ausgabe (Standard: das des Passpunktlayers, sonst die UTM-Zone der EXIF-GNSS-Positionen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="138" />
+            <location filename="../processing/help/__init__.py" line="136" />
             <source>Larger image side at which features are detected, pixels.</source>
             <translation>Längere Bildseite, auf der die Merkmale detektiert werden, Pixel.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="139" />
+            <location filename="../processing/help/__init__.py" line="137" />
             <source>Features kept per image.</source>
             <translation>Pro Bild behaltene Merkmale.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="140" />
+            <location filename="../processing/help/__init__.py" line="138" />
             <source>Estimate f, cx, cy, k1, k2, p1, p2 in the adjustment when no CAMERA file is given (else hold the prior interior orientation).</source>
             <translation>f, cx, cy, k1, k2, p1, p2 in der Ausgleichung schätzen, wenn keine CAMERA-Datei angegeben ist (sonst die vorgegebene innere Orientierung festhalten).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="142" />
+            <location filename="../processing/help/__init__.py" line="140" />
             <source>The adjusted orientation (TruOrtho JSON).</source>
             <translation>Die ausgeglichene Orientierung (TruOrtho-JSON).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="143" />
-            <source>HTML report (and a JSON file of the same name): sigma0, image RMS, per-image residuals, GCP and check point tables, residual vector plots, tie-point multiplicity histogram, block overview.</source>
-            <translation>HTML-Bericht (und eine gleichnamige JSON-Datei): Sigma0, Bild-RMS, Residuen je Bild, Tabellen der Pass- und Kontrollpunkte, Residuenvektor-Grafiken, Histogramm der Vielfachheit der Verknüpfungspunkte, Verbandsübersicht.</translation>
+            <location filename="../processing/help/__init__.py" line="141" />
+            <source>HTML report (and a JSON file of the same name): sigma0, image RMS, per-image residuals, GCP and check point tables, residual vector plots, tie-point multiplicity histogram, block overview. Optional: by default written beside ORIENTATION as name_report.html.</source>
+            <translation>HTML-Bericht (und eine gleichnamige JSON-Datei): Sigma0, Bild-RMS, Residuen je Bild, Tabellen der Pass- und Kontrollpunkte, Residuenvektor-Grafiken, Histogramm der Vielfachheit der Verknüpfungspunkte, Verbandsübersicht. Optional: standardmäßig neben ORIENTATION als name_report.html geschrieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="146" />
-            <source>Projection centres (PointZ) with omega, phi, kappa.</source>
-            <translation>Projektionszentren (PointZ) mit omega, phi, kappa.</translation>
+            <location filename="../processing/help/__init__.py" line="145" />
+            <source>Optional: projection centres (PointZ) with omega, phi, kappa; skipped when not given.</source>
+            <translation>Optional: Projektionszentren (PointZ) mit omega, phi, kappa; entfällt, wenn nicht angegeben.</translation>
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="147" />
@@ -1355,486 +1355,486 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="187" />
-            <source>Folder of the products (created when missing; existing products are replaced).</source>
-            <translation>Ordner der Produkte (wird angelegt, falls er fehlt; vorhandene Produkte werden ersetzt).</translation>
+            <source>Folder of the products (created when missing; existing products are replaced). It holds only products: orientation.json (adjusted orientation), report.html and report.json (the quality report and its data), dsm_raw.tif (DSM as matched, before filtering), confidence.tif (matching confidence 0 to 1), orthoimage.tif (colour of each DSM cell from the matching, not a true orthophoto), dsm.tif (filtered DSM), pointcloud.laz, mesh.ply, trueortho.tif, source_index.tif (which photo each true-orthophoto cell comes from), occlusion.tif and seamlines.gpkg. Caches (compiled kernels, image features) are kept in the per-user cache folder (environment variable TRUORTHO_CACHE_DIR; truortho:environment shows and clears it).</source>
+            <translation>Ordner der Produkte (wird angelegt, falls er fehlt; vorhandene Produkte werden ersetzt). Er enthält nur Produkte: orientation.json (ausgeglichene Orientierung), report.html und report.json (der Qualitätsbericht und seine Daten), dsm_raw.tif (DOM wie zugeordnet, vor der Filterung), confidence.tif (Zuordnungskonfidenz 0 bis 1), orthoimage.tif (Farbe jeder DOM-Zelle aus der Zuordnung, kein True-Orthophoto), dsm.tif (gefiltertes DOM), pointcloud.laz, mesh.ply, trueortho.tif, source_index.tif (aus welchem Foto jede True-Orthophoto-Zelle stammt), occlusion.tif und seamlines.gpkg. Caches (kompilierte Kernel, Bildmerkmale) liegen im benutzereigenen Cache-Ordner (Umgebungsvariable TRUORTHO_CACHE_DIR; truortho:environment zeigt und leert ihn).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="188" />
+            <location filename="../processing/help/__init__.py" line="196" />
             <source>orientation.json: the adjusted orientation.</source>
             <translation>orientation.json: die ausgeglichene Orientierung.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="189" />
+            <location filename="../processing/help/__init__.py" line="197" />
             <source>report.html (and report.json): the quality report of the run.</source>
             <translation>report.html (und report.json): der Qualitätsbericht des Laufs.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="190" />
+            <location filename="../processing/help/__init__.py" line="198" />
             <source>dsm.tif: the filtered DSM (float32, nodata -9999).</source>
             <translation>dsm.tif: das gefilterte DOM (float32, NoData -9999).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="191" />
+            <location filename="../processing/help/__init__.py" line="199" />
             <source>pointcloud.laz: the matched points with colour and confidence.</source>
             <translation>pointcloud.laz: die zugeordneten Punkte mit Farbe und Konfidenz.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="192" />
+            <location filename="../processing/help/__init__.py" line="200" />
             <source>mesh.ply: 2.5D mesh of the filtered DSM with vertical walls and vertex colours.</source>
             <translation>mesh.ply: 2,5D-Dreiecksnetz des gefilterten DOM mit senkrechten Wänden und Eckpunktfarben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="193" />
+            <location filename="../processing/help/__init__.py" line="201" />
             <source>trueortho.tif: the true orthophoto (bands of the photos + alpha, COG).</source>
             <translation>trueortho.tif: das True Orthophoto (Kanäle der Fotos + Alpha, COG).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="194" />
+            <location filename="../processing/help/__init__.py" line="202" />
             <source>occlusion.tif: 1 where no photo sees the surface.</source>
             <translation>occlusion.tif: 1, wo kein Foto die Oberfläche sieht.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="195" />
+            <location filename="../processing/help/__init__.py" line="203" />
             <source>seamlines.gpkg: one polygon per source photo.</source>
             <translation>seamlines.gpkg: ein Polygon je Quellfoto.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="200" />
+            <location filename="../processing/help/__init__.py" line="208" />
             <source>Dense image matching in object space (OSGM): computes a DSM directly on a ground grid from the oriented images, without rectification or pairwise depth maps. For every tile of the grid the images that see it (at most MAX_IMAGES) are resampled onto the horizontal plane of every search height (voxels of RESOLUTION x RESOLUTION x Z_STEP); a matching cost from all of them per cell and height is aggregated by semi-global matching along 8 or 16 paths (penalty P1 for a change of one height step, P2 for larger jumps, lowered across image edges), and each cell takes the height of least aggregated cost, refined between steps, with a confidence in [0, 1]. Matching runs coarse to fine over an image pyramid, by tiles, with progress and cancel. Cells without a reliable match are nodata (filter and fill them with truortho:dsmfilter). Optionally writes the confidence, an orthoimage coloured from the matched images, and a point cloud; with OBLIQUE = auto, groups of oblique images are matched in extra reference systems along their viewing directions, whose points (facades) go to the point cloud.</source>
             <translation>Dichte Bildzuordnung im Objektraum (OSGM): berechnet ein DOM direkt auf einem Bodenraster aus den orientierten Bildern, ohne Epipolarentzerrung oder paarweise Tiefenkarten. Für jede Kachel des Rasters werden die Bilder, die sie sehen (höchstens MAX_IMAGES), auf die horizontale Ebene jeder Suchhöhe umgebildet (Voxel von RESOLUTION x RESOLUTION x Z_STEP); ein Zuordnungskostenwert aus allen diesen Bildern je Zelle und Höhe wird durch Semi-Global Matching entlang 8 oder 16 Pfaden aggregiert (Strafterm P1 für eine Änderung um einen Höhenschritt, P2 für größere Sprünge, an Bildkanten verringert), und jede Zelle erhält die Höhe mit den geringsten aggregierten Kosten, zwischen den Schritten verfeinert, mit einer Konfidenz in [0, 1]. Die Zuordnung läuft grob-zu-fein über eine Bildpyramide, kachelweise, mit Fortschrittsanzeige und Abbruchmöglichkeit. Zellen ohne zuverlässige Zuordnung sind NoData (mit truortho:dsmfilter filtern und füllen). Optional werden die Konfidenz, ein aus den zugeordneten Bildern eingefärbtes Orthobild und eine Punktwolke geschrieben; mit OBLIQUE = auto werden Gruppen von Schrägbildern in zusätzlichen Referenzsystemen entlang ihrer Blickrichtungen zugeordnet, deren Punkte (Fassaden) in die Punktwolke gehen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="214" />
+            <location filename="../processing/help/__init__.py" line="222" />
             <source>Orientation JSON (from Orient images or Import orientation) with a projected CRS (metres) and at least two images, which must be on disk.</source>
             <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren) mit einem projizierten KBS (Meter) und mindestens zwei Bildern, die auf der Festplatte vorhanden sein müssen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="216" />
+            <location filename="../processing/help/__init__.py" line="224" />
             <source>Area to match (reprojected to the orientation's CRS); default the extent of the sparse points (1-99 %), else the union of the near-nadir image footprints. It must intersect the area the images see.</source>
             <translation>Zuzuordnender Bereich (in das KBS der Orientierung umprojiziert); Standard ist die Ausdehnung der dünnen Punktwolke (1-99 %), sonst die Vereinigung der Bildabdeckungen der nadirnahen Bilder. Er muss den von den Bildern gesehenen Bereich schneiden.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="219" />
+            <location filename="../processing/help/__init__.py" line="227" />
             <source>Cell size of the DSM, metres; empty or 0 = the median ground sample distance of the near-nadir images.</source>
             <translation>Zellgröße des DOM, Meter; leer oder 0 = mittlere Bodenpixelgröße (Median) der nadirnahen Bilder.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="221" />
+            <location filename="../processing/help/__init__.py" line="229" />
             <source>Height step between two search planes, metres; empty or 0 = the resolution.</source>
             <translation>Höhenschritt zwischen zwei Suchebenen, Meter; leer oder 0 = die Auflösung.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="222" />
+            <location filename="../processing/help/__init__.py" line="230" />
             <source>Lowest height searched (world Z, the orientation's vertical datum); empty = from the sparse points (0.5 % percentile minus a margin), else from the GCP heights. Must be below Z_MAX.</source>
             <translation>Niedrigste gesuchte Höhe (Welt-Z, das Höhendatum der Orientierung); leer = aus der dünnen Punktwolke (0,5-%-Perzentil minus einem Rand), sonst aus den Passpunkthöhen. Muss unter Z_MAX liegen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="225" />
+            <location filename="../processing/help/__init__.py" line="233" />
             <source>Highest height searched; empty = from the sparse points (99.5 % percentile plus a margin), else half the flying height above the highest GCP. Always kept below the cameras. Without sparse points or GCPs give Z_MIN and Z_MAX.</source>
             <translation>Höchste gesuchte Höhe; leer = aus der dünnen Punktwolke (99,5-%-Perzentil plus einem Rand), sonst die halbe Flughöhe über dem höchsten Passpunkt. Bleibt immer unterhalb der Kameras. Ohne dünne Punktwolke oder Passpunkte Z_MIN und Z_MAX angeben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="228" />
+            <location filename="../processing/help/__init__.py" line="236" />
             <source>Optional coarse DSM or DTM raster: the search at each cell is bounded by the lowest and highest height of its neighbourhood plus a margin, which speeds up matching and avoids wrong heights on rough terrain.</source>
             <translation>Optionales grobes DOM- oder DGM-Raster: die Suche an jeder Zelle wird durch die niedrigste und höchste Höhe ihrer Nachbarschaft plus einen Rand begrenzt, was die Zuordnung beschleunigt und falsche Höhen in rauem Gelände vermeidet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="231" />
+            <location filename="../processing/help/__init__.py" line="239" />
             <source>Number of aggregation directions of semi-global matching: 8 (faster) or 16 (smoother slanted surfaces).</source>
             <translation>Anzahl der Aggregationsrichtungen des Semi-Global Matching: 8 (schneller) oder 16 (glattere geneigte Flächen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="233" />
+            <location filename="../processing/help/__init__.py" line="241" />
             <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
             <translation>none: ein Nadir-Referenzsystem (das DOM). auto: Gruppen von Schrägbildern erhalten zusätzlich Referenzsysteme entlang ihrer Blickrichtungen, deren Punkte mit ihrer 'system'-Kennung in die Punktwolke gehen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="236" />
+            <location filename="../processing/help/__init__.py" line="244" />
             <source>Penalty for a change of one height step between neighbouring cells, in cost units (unrelated image windows cost 1023); empty = 256.</source>
             <translation>Strafterm für eine Änderung um einen Höhenschritt zwischen benachbarten Zellen, in Kosteneinheiten (unabhängige Bildfenster kosten 1023); leer = 256.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="238" />
+            <location filename="../processing/help/__init__.py" line="246" />
             <source>Penalty for a larger height jump, above P1 and at most 3072; empty = 2048 (a jump then needs contrary evidence from two cells).</source>
             <translation>Strafterm für einen größeren Höhensprung, über P1 und höchstens 3072; leer = 2048 (ein Sprung erfordert dann Gegenevidenz aus zwei Zellen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="240" />
+            <location filename="../processing/help/__init__.py" line="248" />
             <source>Largest number of images matched per tile (best coverage first, then the most nadir); memory and time grow with it.</source>
             <translation>Größte Anzahl pro Kachel zugeordneter Bilder (beste Abdeckung zuerst, dann die nadirnächsten); Speicherbedarf und Rechenzeit wachsen damit.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="242" />
+            <location filename="../processing/help/__init__.py" line="250" />
             <source>Tile side in cells; memory grows with its square, the number of search heights and MAX_IMAGES.</source>
             <translation>Kachelseite in Zellen; der Speicherbedarf wächst mit ihrem Quadrat, der Anzahl der Suchhöhen und MAX_IMAGES.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="244" />
+            <location filename="../processing/help/__init__.py" line="252" />
             <source>Where the tiles are matched; the DSM and confidence are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with the same inputs and parameters after a crash reuses them.</source>
             <translation>Wo die Kacheln zugeordnet werden; DOM und Konfidenz sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Fertige Kacheln werden bis zum Ende des Laufs neben dem DOM aufbewahrt (DSM.tif.tiles), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="253" />
+            <location filename="../processing/help/__init__.py" line="261" />
             <source>The raw DSM: GeoTIFF, float32, in the orientation's CRS, nodata -9999.</source>
             <translation>Das rohe DOM: GeoTIFF, float32, im KBS der Orientierung, NoData -9999.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="254" />
+            <location filename="../processing/help/__init__.py" line="262" />
             <source>Optional confidence GeoTIFF (float32 in [0, 1], nodata -1) on the DSM grid, for truortho:dsmfilter.</source>
             <translation>Optionales Konfidenz-GeoTIFF (float32 in [0, 1], NoData -1) auf dem DOM-Raster, für truortho:dsmfilter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="256" />
+            <location filename="../processing/help/__init__.py" line="264" />
             <source>Optional RGB orthoimage GeoTIFF (uint8, 0 = no data) on the DSM grid, coloured from the matched images; not a true orthophoto (use truortho:trueortho for that).</source>
             <translation>Optionales RGB-Orthobild als GeoTIFF (uint8, 0 = keine Daten) auf dem DOM-Raster, aus den zugeordneten Bildern eingefärbt; kein True Orthophoto (dafür truortho:trueortho verwenden).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="258" />
+            <location filename="../processing/help/__init__.py" line="266" />
             <source>Optional point cloud (.laz or .las; LAS 1.4 with colours, 'confidence' and 'system', the reference system of each point).</source>
             <translation>Optionale Punktwolke (.laz oder .las; LAS 1.4 mit Farben, 'confidence' und 'system', dem Referenzsystem jedes Punktes).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="260" />
+            <location filename="../processing/help/__init__.py" line="268" />
             <source>JSON: grid size, resolution, height step and range (and where it came from), pyramid levels, tiles, completeness, mean confidence, reference systems, time.</source>
             <translation>JSON: Rastergröße, Auflösung, Höhenschritt und -bereich (und woher er stammt), Pyramidenstufen, Kacheln, Vollständigkeit, mittlere Konfidenz, Referenzsysteme, Zeit.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="266" />
+            <location filename="../processing/help/__init__.py" line="274" />
             <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
             <translation>Berechnet ein True Orthophoto aus orientierten Bildern und einer Oberfläche (einem DOM-Raster wie dem von OSGM oder einem PLY/OBJ-Dreiecksnetz): jede Zelle wird aus einem Bild eingefärbt, das sie wirklich sieht, ermittelt mit einem Tiefenpuffer der Oberfläche je Bild (DOM-Zellen als flache Dächer mit senkrechten Wänden an Höhensprüngen, oder die Dreiecke des Netzes; Frustum- und Rückseiten-Culling). Unter den Bildern, die eine Zelle sehen, wird dasjenige mit der feinsten effektiven Bodenauflösung (Entfernung und Einfallswinkel auf der Oberfläche) bevorzugt; Dächer werden jeweils aus einem einzigen Bild texturiert, und die Nahtlinien folgen Höhensprüngen und meiden Stellen, an denen die Bilder nicht übereinstimmen (Label-Glättung), mit Überblendung über die Nähte nur zwischen Bildern, die beide die Zellen sehen. Farbkorrekturen je Bild in CIE L*a*b* (Verstärkung/Versatz je Kanal für Nicht-RGB-Daten) werden per Ausgleichung nach kleinsten Quadraten aus Zellen geschätzt, die mehrere Bilder sehen. Zellen, die kein Bild sieht, erhalten Alpha 0 und erscheinen in der Verdeckungsmaske. Kanalanzahl und Datentyp der Bilder bleiben erhalten (RGB, 16-Bit-panchromatisch, thermal). Die Verarbeitung läuft kachelweise mit begrenztem Speicher; Fortschritt und Abbruch je Kachel.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="280" />
+            <location filename="../processing/help/__init__.py" line="288" />
             <source>Orientation JSON (from Orient images or Import orientation); its images must be on disk.</source>
             <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren); seine Bilder müssen auf der Festplatte vorhanden sein.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="282" />
+            <location filename="../processing/help/__init__.py" line="290" />
             <source>DSM GeoTIFF (any CRS; resampled onto the output grid by nearest neighbour) or a PLY/OBJ mesh. Heights must use the orientation's vertical datum. It must cover the extent.</source>
             <translation>DOM-GeoTIFF (beliebiges KBS; per nächstem Nachbarn auf das Ausgaberaster umgebildet) oder ein PLY/OBJ-Dreiecksnetz. Die Höhen müssen das Höhendatum der Orientierung verwenden. Es muss die Ausdehnung abdecken.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="284" />
+            <location filename="../processing/help/__init__.py" line="292" />
             <source>Output extent; default the surface's extent.</source>
             <translation>Ausgabeausdehnung; Standard ist die Ausdehnung der Oberfläche.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="285" />
+            <location filename="../processing/help/__init__.py" line="293" />
             <source>Output cell size in units of the output CRS; 0 = the DSM's cell size.</source>
             <translation>Ausgabezellgröße in Einheiten des Ausgabe-KBS; 0 = Zellgröße des DOM.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="286" />
+            <location filename="../processing/help/__init__.py" line="294" />
             <source>Output CRS; default the orientation's. When it differs, the computation runs on the output grid and cell centres are transformed to the orientation's CRS (images are resampled once).</source>
             <translation>Ausgabe-KBS; Standard ist das der Orientierung. Weicht es ab, läuft die Berechnung auf dem Ausgaberaster, und die Zellmittelpunkte werden in das KBS der Orientierung transformiert (die Bilder werden nur einmal umgebildet).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="289" />
+            <location filename="../processing/help/__init__.py" line="297" />
             <source>Estimate and apply per-image colour corrections before mosaicking.</source>
             <translation>Farbkorrekturen je Bild vor der Mosaikbildung schätzen und anwenden.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="290" />
+            <location filename="../processing/help/__init__.py" line="298" />
             <source>Largest off-nadir angle of the viewing ray (degrees) for an image to texture a cell; also bounds how far outside a tile occluders are searched.</source>
             <translation>Größter Winkel des Sehstrahls zum Nadir (Grad), unter dem ein Bild eine Zelle texturieren darf; begrenzt auch, wie weit außerhalb einer Kachel nach verdeckenden Objekten gesucht wird.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="292" />
+            <location filename="../processing/help/__init__.py" line="300" />
             <source>Width of the feathering across seamlines, in cells (0 = hard seams).</source>
             <translation>Breite der Überblendung an den Nahtlinien, in Zellen (0 = harte Nähte).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="293" />
+            <location filename="../processing/help/__init__.py" line="301" />
             <source>Tile side in cells; memory grows with its square and the images per tile.</source>
             <translation>Kachelseite in Zellen; der Speicherbedarf wächst mit ihrem Quadrat und den Bildern pro Kachel.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="294" />
+            <location filename="../processing/help/__init__.py" line="302" />
             <source>Compression of the orthophoto. DEFLATE (the default), ZSTD and LZW are lossless: DEFLATE gives the smallest files and every GIS reads it; ZSTD (level 1) writes about twice as fast and about 9 % larger (GDAL 2.3 or later reads it); LZW is for older readers. JPEG is lossy (about a fifth of the size), for 8-bit RGB images only: RGB is stored as YCbCr with halved colour resolution, so colours blur across sharp edges such as building outlines (deliver and view with it; measure on a lossless one), and the alpha band becomes the file's internal mask. The source index and occlusion mask always stay lossless.</source>
             <translation>Kompression des Orthophotos. DEFLATE (Standard), ZSTD und LZW sind verlustfrei: DEFLATE ergibt die kleinsten Dateien und jedes GIS liest es; ZSTD (Stufe 1) schreibt etwa doppelt so schnell und etwa 9 % größer (lesbar ab GDAL 2.3); LZW ist für ältere Leseprogramme. JPEG ist verlustbehaftet (etwa ein Fünftel der Größe), nur für 8-Bit-RGB-Bilder: RGB wird als YCbCr mit halbierter Farbauflösung gespeichert, sodass Farben über scharfe Kanten wie Gebäudeumrisse verschwimmen (zum Ausliefern und Ansehen; gemessen wird an einer verlustfreien Datei), und das Alphaband wird zur internen Maske der Datei. Quellbildindex und Verdeckungsmaske bleiben immer verlustfrei.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="301" />
+            <location filename="../processing/help/__init__.py" line="309" />
             <source>JPEG quality (1-100) when COMPRESSION is JPEG.</source>
             <translation>JPEG-Qualität (1-100), wenn COMPRESSION JPEG ist.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="302" />
+            <location filename="../processing/help/__init__.py" line="310" />
             <source>Where the tiles of the mosaic are computed; the true orthophoto, source index, occlusion mask and seamlines are identical with every choice. inprocess: in QGIS's process, the independent tiles of a wave in parallel threads (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images and the surface at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The colour correction (on a decimated grid) is estimated in QGIS's process. Finished tiles are kept in a folder beside the output (its name plus '.tiles') until the run succeeds, so a rerun with the same inputs and parameters after a crash reuses them.</source>
             <translation>Wo die Kacheln des Mosaiks berechnet werden; True Orthophoto, Quellbildindex, Verdeckungsmaske und Nahtlinien sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, die unabhängigen Kacheln einer Welle parallel in Threads (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder und die Oberfläche unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Der Farbausgleich (auf einem ausgedünnten Raster) wird im Prozess von QGIS geschätzt. Fertige Kacheln werden bis zum erfolgreichen Ende des Laufs in einem Ordner neben der Ausgabe aufbewahrt (ihr Name plus '.tiles'), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="314" />
+            <location filename="../processing/help/__init__.py" line="322" />
             <source>GeoTIFF with the images' bands and data type plus an alpha band (an internal mask with JPEG compression), tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
             <translation>GeoTIFF mit den Bändern und dem Datentyp der Bilder plus einem Alphaband (bei JPEG-Kompression eine interne Maske), gekachelt, mit Übersichten, im Cloud-Optimized-GeoTIFF-Layout.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="316" />
+            <location filename="../processing/help/__init__.py" line="324" />
             <source>Int16 GeoTIFF: index (0-based, orientation order) of the image each cell comes from; -1 = nodata.</source>
             <translation>Int16-GeoTIFF: Index (ab 0, Reihenfolge der Orientierung) des Bildes, aus dem jede Zelle stammt; -1 = NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="318" />
+            <location filename="../processing/help/__init__.py" line="326" />
             <source>UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the surface has no data.</source>
             <translation>UInt8-GeoTIFF: 1, wo kein Bild die Zelle sieht, 0, wo sie gesehen wird, 255, wo die Oberfläche keine Daten hat.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="320" />
+            <location filename="../processing/help/__init__.py" line="328" />
             <source>Polygons, one feature per source image: the cells it colours (image_index, image, cells, area).</source>
             <translation>Polygone, ein Objekt pro Quellbild: die Zellen, die es einfärbt (image_index, image, cells, area).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="326" />
+            <location filename="../processing/help/__init__.py" line="334" />
             <source>Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the cells of blurred height steps to the nearer side, removes outliers (cells that depart from the confidence-weighted median of their window by more than the threshold and have too few neighbours at their height, so roof edges and corners survive), fills holes up to a maximum width by harmonic interpolation (holes at the foot of walls from the ground side only; wider holes stay nodata and are reported), and optionally smooths planar surfaces without blurring their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the statistics (removed outliers, filled cells, remaining holes) are returned and logged.</source>
             <translation>Bereinigt ein rohes DOM (z. B. das DOM der dichten Bildzuordnung aus dem OSGM-Schritt von TruOrtho) kachelweise: schiebt die Zellen verschliffener Höhensprünge auf die nähere Seite, entfernt Ausreißer (Zellen, die um mehr als die Schwelle vom konfidenzgewichteten Median ihres Fensters abweichen und zu wenige Nachbarn auf ihrer Höhe haben, sodass Dachkanten und Ecken erhalten bleiben), füllt Lücken bis zu einer Höchstbreite durch harmonische Interpolation (Lücken am Fuß von Wänden nur von der Bodenseite aus; breitere Lücken bleiben NoData und werden gemeldet) und glättet optional ebene Flächen, ohne ihre Kanten zu verwischen. Optional wird ein Geländemodell (DGM) durch Bodenfilterung nach Art von SMRF abgeleitet sowie das normalisierte DOM (Höhe über Gelände). Die Ausgaben behalten KBS, Raster und NoData der Eingabe; die Statistik (entfernte Ausreißer, gefüllte Zellen, verbleibende Lücken) wird zurückgegeben und protokolliert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="337" />
+            <location filename="../processing/help/__init__.py" line="345" />
             <source>Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.</source>
             <translation>Rohes DOM: einkanaliges Raster mit einem projizierten KBS (Meter); seine NoData-Zellen sind Lücken.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="338" />
+            <location filename="../processing/help/__init__.py" line="346" />
             <source>Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum confidence are removed, less confident cells must agree better with their neighbours, and the median is weighted by confidence.</source>
             <translation>Optionales Konfidenzraster in [0, 1] (CONFIDENCE von OSGM): Zellen unter der Mindestkonfidenz werden entfernt, weniger zuverlässige Zellen müssen besser mit ihren Nachbarn übereinstimmen, und der Median wird mit der Konfidenz gewichtet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="341" />
+            <location filename="../processing/help/__init__.py" line="349" />
             <source>Largest departure from the neighbourhood median, metres (empty: 4 x the resolution).</source>
             <translation>Größte Abweichung vom Median der Nachbarschaft, Meter (leer: 4 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="343" />
+            <location filename="../processing/help/__init__.py" line="351" />
             <source>Side of the median window in cells (odd); a second pass uses twice the window.</source>
             <translation>Seitenlänge des Medianfensters in Zellen (ungerade); ein zweiter Durchlauf verwendet das doppelte Fenster.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="345" />
+            <location filename="../processing/help/__init__.py" line="353" />
             <source>Neighbours within the threshold of a cell's height that keep it although it departs from the median (edges, corners, thin structures).</source>
             <translation>Nachbarn innerhalb der Schwelle um die Höhe einer Zelle, die sie erhalten, obwohl sie vom Median abweicht (Kanten, Ecken, dünne Strukturen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="347" />
+            <location filename="../processing/help/__init__.py" line="355" />
             <source>With a confidence raster: cells below this confidence are removed.</source>
             <translation>Mit einem Konfidenzraster: Zellen unter dieser Konfidenz werden entfernt.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="348" />
+            <location filename="../processing/help/__init__.py" line="356" />
             <source>With a confidence raster: less confident cells are removed when they depart by more than the threshold from the median of the cells at least this confident in their 15 x 15 window (0: off).</source>
             <translation>Mit einem Konfidenzraster: weniger zuverlässige Zellen werden entfernt, wenn sie um mehr als die Schwelle vom Median der Zellen mit mindestens dieser Konfidenz in ihrem 15-x-15-Fenster abweichen (0: aus).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="351" />
+            <location filename="../processing/help/__init__.py" line="359" />
             <source>Largest hole width (metres) that is interpolated; 0 fills nothing.</source>
             <translation>Größte Lückenbreite (Meter), die interpoliert wird; 0 füllt nichts.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="352" />
+            <location filename="../processing/help/__init__.py" line="360" />
             <source>Height difference between two surfaces (a wall), metres: hole boundary cells that much above nearby boundary cells are not interpolated from.</source>
             <translation>Höhenunterschied zwischen zwei Oberflächen (eine Wand), Meter: Randzellen einer Lücke, die so viel höher als benachbarte Randzellen liegen, werden nicht zur Interpolation verwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="354" />
+            <location filename="../processing/help/__init__.py" line="362" />
             <source>Snap the cells of blurred height steps (between the two levels of their 5 x 5 window) to the nearer level.</source>
             <translation>Die Zellen verschliffener Höhensprünge (zwischen den beiden Niveaus ihres 5-x-5-Fensters) auf das nähere Niveau schieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="356" />
+            <location filename="../processing/help/__init__.py" line="364" />
             <source>Replace cells by a local plane fitted to the neighbours at their height (flat and pitched roofs, streets); steps stay sharp.</source>
             <translation>Zellen durch eine lokale Ebene ersetzen, die an die Nachbarn auf ihrer Höhe angepasst ist (Flach- und Schrägdächer, Straßen); Sprünge bleiben scharf.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="358" />
+            <location filename="../processing/help/__init__.py" line="366" />
             <source>Radius of the smoothing neighbourhood, cells.</source>
             <translation>Radius der Glättungsnachbarschaft, Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="359" />
+            <location filename="../processing/help/__init__.py" line="367" />
             <source>Neighbours within this height of a cell belong to its surface, metres (empty: 2.5 x the resolution).</source>
             <translation>Nachbarn innerhalb dieser Höhe um eine Zelle gehören zu ihrer Oberfläche, Meter (leer: 2,5 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="361" />
+            <location filename="../processing/help/__init__.py" line="369" />
             <source>Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); the DTM is written on the DSM grid.</source>
             <translation>Zellgröße des Bodenfilters, Meter (leer: max(1 m, DOM-Auflösung)); das DGM wird auf dem DOM-Raster geschrieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="363" />
+            <location filename="../processing/help/__init__.py" line="371" />
             <source>Largest opening radius of the ground filter, metres: more than half the width of the largest building.</source>
             <translation>Größter Öffnungsradius des Bodenfilters, Meter: mehr als die halbe Breite des größten Gebäudes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="365" />
+            <location filename="../processing/help/__init__.py" line="373" />
             <source>Terrain slope (rise over run) the ground filter keeps as ground.</source>
             <translation>Geländeneigung (Höhe pro Strecke), die der Bodenfilter als Boden behält.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="366" />
+            <location filename="../processing/help/__init__.py" line="374" />
             <source>Where the tiles are filtered; the filtered DSM and the statistics are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The terrain model is computed in QGIS's process.</source>
             <translation>Wo die Kacheln gefiltert werden; gefiltertes DOM und Statistik sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen das DOM und das Konfidenzraster unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Das Geländemodell wird im Prozess von QGIS berechnet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="374" />
+            <location filename="../processing/help/__init__.py" line="382" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>Gefiltertes DOM (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="375" />
+            <location filename="../processing/help/__init__.py" line="383" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Optionales Geländemodell (GeoTIFF, float32, DOM-Raster).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="376" />
+            <location filename="../processing/help/__init__.py" line="384" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>Optionales normalisiertes DOM: DOM minus DGM, Höhen über dem Gelände.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="377" />
+            <location filename="../processing/help/__init__.py" line="385" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON: die Filterstatistik (und die des Bodenfilters).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="378" />
+            <location filename="../processing/help/__init__.py" line="386" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Als Ausreißer oder wegen geringer Konfidenz entfernte Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="379" />
+            <location filename="../processing/help/__init__.py" line="387" />
             <source>Hole cells interpolated.</source>
             <translation>Interpolierte Lückenzellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="380" />
+            <location filename="../processing/help/__init__.py" line="388" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Lücken, breiter als MAX_HOLE, als NoData belassen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="385" />
+            <location filename="../processing/help/__init__.py" line="393" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Erzeugt eine Dreiecksvermaschung. Aus einem DOM: ein 2,5D-Netz, dessen Höhensprünge senkrechte Wände sind (kein Dreieck überspannt je einen Sprung) und dessen ebene und glatte Bereiche durch einen eingeschränkten Quadtree mit garantierter Höhenfehlerschranke an jedem Zellmittelpunkt ausgedünnt werden; Eckpunktfarben aus einem optionalen Orthobild. Aus einer Punktwolke (LAS/LAZ oder EPT, z. B. zusammengeführte Zuordnung von Schrägbildern): ein 2,5D-Delaunay-Netz je Referenzsystem, entlang seiner Blickrichtung gesehen (überlappende Schichten, wo Systeme dieselbe Oberfläche sehen; nicht wasserdicht). Schreibt PLY (binär) oder OBJ, im KBS oder in einem lokalen System, dessen Offset im Dateikopf vermerkt ist; truortho:trueortho liest es als SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="394" />
+            <location filename="../processing/help/__init__.py" line="402" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>DOM-Raster (projiziertes KBS) oder Punktwolke (.las, .laz oder eine EPT-ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="395" />
+            <location filename="../processing/help/__init__.py" line="403" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Optionales Orthobild (RGB) für die Eckpunktfarben eines DOM-Netzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="396" />
+            <location filename="../processing/help/__init__.py" line="404" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Größter Höhenunterschied zwischen Netz und DOM an einem Zellmittelpunkt, Meter (leer: halbe DOM-Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="398" />
+            <location filename="../processing/help/__init__.py" line="406" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Kleinster Höhenunterschied zwischen benachbarten Zellen, der zur Wand wird, Meter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="399" />
+            <location filename="../processing/help/__init__.py" line="407" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Steilste als geneigte Dreiecke erhaltene Neigung, Grad: die Sprungschwelle ist max(MIN_STEP, Auflösung x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="401" />
+            <location filename="../processing/help/__init__.py" line="409" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Größter Zellblock, den ein Dreieckspaar abdecken darf (eine Zweierpotenz).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="402" />
+            <location filename="../processing/help/__init__.py" line="410" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Punktwolken: längste Dreieckskante, Meter (leer: 4 x der mittlere Punktabstand).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="403" />
+            <location filename="../processing/help/__init__.py" line="411" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>CRS: Weltkoordinaten (PLY-Doubles). Lokal: Welt minus einem Offset, vermerkt als 'comment offset E N H' (PLY) oder '# offset E N H' (OBJ), für Viewer, die kleine Zahlen benötigen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="405" />
+            <location filename="../processing/help/__init__.py" line="413" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Das Netz: .ply (binär, Little-Endian, 'comment crs ...') oder .obj ('# crs ...', Eckpunktfarben als 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="407" />
+            <location filename="../processing/help/__init__.py" line="415" />
             <source>Number of vertices.</source>
             <translation>Anzahl der Eckpunkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="408" />
+            <location filename="../processing/help/__init__.py" line="416" />
             <source>Number of triangles.</source>
             <translation>Anzahl der Dreiecke.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="409" />
+            <location filename="../processing/help/__init__.py" line="417" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Anzahl der senkrechten Wanddreiecke (DOM-Netze).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="414" />
-            <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (Layer &gt; Add Layer &gt; Point Cloud, choose ept.json).</source>
-            <translation>Exportiert ein DOM als Punktwolke, ein Punkt je gültigem Zellmittelpunkt, mit Farben aus einem Orthobild und Konfidenz je Punkt aus einem Konfidenzraster: LAS 1.4 oder LAZ (Punktformat 7, KBS als WKT, Zusatzdimensionen 'confidence' und 'system' (das Referenzsystem), ein TruOrtho-VLR, der die Referenzsysteme beschreibt), lesbar mit PDAL, laspy, LAStools und CloudCompare. Daneben wird ein Entwine-Point-Tile-Datensatz (EPT) geschrieben: QGIS-Builds ohne PDAL (wie das QGIS 3.22 von Debian) öffnen ihn als Punktwolken-Layer (Layer &gt; Layer hinzufügen &gt; Punktwolke, ept.json wählen).</translation>
+            <location filename="../processing/help/__init__.py" line="422" />
+            <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (menu Layer, Add Layer, Add Point Cloud Layer; choose ept.json).</source>
+            <translation>Exportiert ein DOM als Punktwolke, ein Punkt je gültigem Zellmittelpunkt, mit Farben aus einem Orthobild und Konfidenz je Punkt aus einem Konfidenzraster: LAS 1.4 oder LAZ (Punktformat 7, KBS als WKT, Zusatzdimensionen 'confidence' und 'system' (das Referenzsystem), ein TruOrtho-VLR, der die Referenzsysteme beschreibt), lesbar mit PDAL, laspy, LAStools und CloudCompare. Daneben wird ein Entwine-Point-Tile-Datensatz (EPT) geschrieben: QGIS-Builds ohne PDAL (wie das QGIS 3.22 von Debian) öffnen ihn als Punktwolken-Layer (Menü Layer, Layer hinzufügen, Punktwolken-Layer hinzufügen; ept.json wählen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="422" />
+            <location filename="../processing/help/__init__.py" line="431" />
             <source>DSM raster with a projected CRS.</source>
             <translation>DOM-Raster mit einem projizierten KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="423" />
+            <location filename="../processing/help/__init__.py" line="432" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Optionales Orthobild (RGB) für die Punktfarben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="424" />
+            <location filename="../processing/help/__init__.py" line="433" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Optionales Konfidenzraster in [0, 1], gespeichert als Dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="425" />
+            <location filename="../processing/help/__init__.py" line="434" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Die Punktwolke (.laz komprimiert oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="426" />
+            <location filename="../processing/help/__init__.py" line="435" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Ordner des EPT-Datensatzes (ept.json, ept-data/, ept-hierarchy/); leer lassen, um ihn zu überspringen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="427" />
+            <location filename="../processing/help/__init__.py" line="436" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Pfad der ept.json des EPT-Datensatzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="428" />
+            <location filename="../processing/help/__init__.py" line="437" />
             <source>Number of points written.</source>
             <translation>Anzahl der geschriebenen Punkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="433" />
+            <location filename="../processing/help/__init__.py" line="442" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Führt Punktwolken mehrerer Referenzsysteme (z. B. das Nadir- und die Schrägsysteme der dichten Bildzuordnung) in einer LAS-1.4-/LAZ-Datei zusammen und behält dabei 'system' jedes Punktes (Dateien ohne dieses Attribut erhalten den Index ihrer Datei) und seine Konfidenz; dünnt optional Duplikate auf einem Voxelgitter aus und behält den zuverlässigsten Punkt jedes Voxels; schreibt optional einen EPT-Datensatz für QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="439" />
+            <location filename="../processing/help/__init__.py" line="448" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>LAS/LAZ-Dateien in einem KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="440" />
+            <location filename="../processing/help/__init__.py" line="449" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Voxelgröße für das Ausdünnen, Meter (leer: jeden Punkt behalten).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="441" />
+            <location filename="../processing/help/__init__.py" line="450" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Die zusammengeführte Punktwolke (.laz oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="442" />
+            <location filename="../processing/help/__init__.py" line="451" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Optionaler Ordner für einen EPT-Datensatz der zusammengeführten Wolke.</translation>
         </message>
@@ -1929,22 +1929,22 @@
             <translation>Passpunkt {!r}: Sigmas müssen positiv sein</translation>
         </message>
         <message>
-            <location filename="../processing/provider.py" line="40" />
+            <location filename="../processing/provider.py" line="59" />
             <source>TruOrtho</source>
             <translation>TruOrtho</translation>
         </message>
         <message>
-            <location filename="../processing/provider.py" line="43" />
+            <location filename="../processing/provider.py" line="62" />
             <source>TruOrtho {} — orientation, dense matching and true orthophotos</source>
             <translation>TruOrtho {} — Orientierung, dichte Bildzuordnung und True Orthophotos</translation>
         </message>
         <message>
-            <location filename="../processing/provider.py" line="59" />
+            <location filename="../processing/provider.py" line="78" />
             <source>TruOrtho algorithms could not be loaded: {}</source>
             <translation>TruOrtho-Algorithmen konnten nicht geladen werden: {}</translation>
         </message>
         <message>
-            <location filename="../processing/provider.py" line="77" />
+            <location filename="../processing/provider.py" line="96" />
             <source>TruOrtho model {} could not be loaded</source>
             <translation>TruOrtho-Modell {} konnte nicht geladen werden</translation>
         </message>
@@ -2299,12 +2299,32 @@
             <translation>Der Algorithmus {} ist in dieser Version nicht verfügbar.</translation>
         </message>
         <message>
+            <source>Keep the measurements as a table layer in the project</source>
+            <translation type="obsolete">Messungen als Tabellenlayer im Projekt behalten</translation>
+        </message>
+        <message>
             <source>Reports the versions of QGIS, GDAL, rasterio, numpy, numba, OpenCV and pyproj that TruOrtho runs with, and writes them to a JSON file. Fails if rasterio is linked to a different GDAL than QGIS.</source>
             <translation type="obsolete">Meldet die Versionen von QGIS, GDAL, rasterio, numpy, numba, OpenCV und pyproj, mit denen TruOrtho läuft, und schreibt sie in eine JSON-Datei. Schlägt fehl, wenn rasterio gegen ein anderes GDAL als QGIS gelinkt ist.</translation>
         </message>
         <message>
-            <source>Keep the measurements as a table layer in the project</source>
-            <translation type="obsolete">Messungen als Tabellenlayer im Projekt behalten</translation>
+            <source>Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa (degrees).</source>
+            <translation type="obsolete">Projektionszentren als PointZ mit name, camera, x, y, z, omega, phi, kappa (Grad).</translation>
+        </message>
+        <message>
+            <source>HTML report (and a JSON file of the same name): sigma0, image RMS, per-image residuals, GCP and check point tables, residual vector plots, tie-point multiplicity histogram, block overview.</source>
+            <translation type="obsolete">HTML-Bericht (und eine gleichnamige JSON-Datei): Sigma0, Bild-RMS, Residuen je Bild, Tabellen der Pass- und Kontrollpunkte, Residuenvektor-Grafiken, Histogramm der Vielfachheit der Verknüpfungspunkte, Verbandsübersicht.</translation>
+        </message>
+        <message>
+            <source>Projection centres (PointZ) with omega, phi, kappa.</source>
+            <translation type="obsolete">Projektionszentren (PointZ) mit omega, phi, kappa.</translation>
+        </message>
+        <message>
+            <source>Folder of the products (created when missing; existing products are replaced).</source>
+            <translation type="obsolete">Ordner der Produkte (wird angelegt, falls er fehlt; vorhandene Produkte werden ersetzt).</translation>
+        </message>
+        <message>
+            <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (Layer &gt; Add Layer &gt; Point Cloud, choose ept.json).</source>
+            <translation type="obsolete">Exportiert ein DOM als Punktwolke, ein Punkt je gültigem Zellmittelpunkt, mit Farben aus einem Orthobild und Konfidenz je Punkt aus einem Konfidenzraster: LAS 1.4 oder LAZ (Punktformat 7, KBS als WKT, Zusatzdimensionen 'confidence' und 'system' (das Referenzsystem), ein TruOrtho-VLR, der die Referenzsysteme beschreibt), lesbar mit PDAL, laspy, LAStools und CloudCompare. Daneben wird ein Entwine-Point-Tile-Datensatz (EPT) geschrieben: QGIS-Builds ohne PDAL (wie das QGIS 3.22 von Debian) öffnen ihn als Punktwolken-Layer (Layer &gt; Layer hinzufügen &gt; Punktwolke, ept.json wählen).</translation>
         </message>
         <message>
             <source>GeoTIFF with the images' bands and data type plus an alpha band, tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>

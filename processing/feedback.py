@@ -3,7 +3,8 @@
 ``FeedbackProgress`` adapts a ``QgsProcessingFeedback`` to the core's
 ``Progress`` protocol (:mod:`truortho.core.progress`); :func:`core_errors`
 turns :class:`~truortho.core.errors.TruOrthoError` into
-``QgsProcessingException`` -- the one place where that happens.
+``QgsProcessingException`` -- the one place where that happens -- and makes
+``qgis_process`` print the message of a failed run once (:func:`quiet_console_echo`).
 """
 
 from __future__ import annotations
@@ -42,6 +43,24 @@ class FeedbackProgress:
         return bool(self.feedback is not None and self.feedback.isCanceled())
 
 
+def quiet_console_echo() -> None:
+    """In ``qgis_process`` only: stop echoing the message log, so a failed run's error prints once.
+
+    ``qgis_process`` prints every critical message-log entry to stderr, and QGIS logs the message of
+    a failed run twice besides its own ``ERROR:`` line (``QgsProcessingAlgorithm.run`` and
+    ``QgsProcessingFeedback.reportError``): three copies. Called as the exception leaves the
+    algorithm, when the run is over and ``qgis_process`` is about to exit. The desktop (a log panel,
+    no echo) and ``processing.run`` are left alone.
+    """
+    from qgis.core import QgsApplication
+
+    if QgsApplication.platform() != "qgis_process":
+        return
+    log = QgsApplication.messageLog()
+    if log is not None:
+        log.blockSignals(True)
+
+
 class core_errors(contextlib.ContextDecorator):  # noqa: N801 - used like a function
     """Context manager and decorator: ``TruOrthoError`` -> ``QgsProcessingException``.
 
@@ -60,10 +79,11 @@ class core_errors(contextlib.ContextDecorator):  # noqa: N801 - used like a func
     def __exit__(self, exc_type, exc, tb) -> None:
         if exc is None:
             return
+        if isinstance(exc, QgsProcessingException | TruOrthoError):
+            quiet_console_echo()
         if isinstance(exc, CancelledError):
             detail = str(exc)
             msg = tr("Cancelled by the user")
             raise QgsProcessingException(f"{msg}: {detail}" if detail else msg) from exc
         if isinstance(exc, TruOrthoError):
             raise QgsProcessingException(str(exc)) from exc
-

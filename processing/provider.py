@@ -25,6 +25,25 @@ def _version() -> str:
     return "0"
 
 
+class _Model(QgsProcessingModelAlgorithm):
+    """A shipped model whose help is plain lines, like the algorithms' (:func:`..help.help_text`).
+
+    QGIS renders a model's help map as HTML with escaped quotes, which ``qgis_process help``
+    prints as it is (``&#x27;``); the toolbox wraps each line of plain text in a paragraph.
+    """
+
+    def shortHelpString(self) -> str:  # noqa: N802 - QGIS API
+        content = self.helpContent()
+        lines = [str(content.get("ALG_DESC", ""))]
+        names = [p.name() for p in self.parameterDefinitions()] + [o.name() for o in self.outputDefinitions()]
+        for name in names:
+            # model outputs are named "<child>:<output>", their help under "<output>"
+            text = content.get(name) or content.get(name.split(":")[-1])
+            if text:
+                lines.append(f"{name}: {text}")
+        return "\n".join(line.replace("\n", " ") for line in lines if line)
+
+
 class TruOrthoProvider(QgsProcessingProvider):
     """Provides the algorithms listed in ``truortho.processing.algorithms.ALGORITHMS``.
 
@@ -70,7 +89,7 @@ class TruOrthoProvider(QgsProcessingProvider):
         except OSError:
             return
         for name in names:
-            model = QgsProcessingModelAlgorithm()
+            model = _Model()
             if model.fromFile(os.path.join(MODELS_DIR, name)):
                 self.addAlgorithm(model)
             else:

@@ -14,7 +14,7 @@ from qgis.core import (
     QgsProcessingParameterVectorLayer,
 )
 
-from ..help import help_html, parameter_help
+from ..help import help_text, parameter_help
 from ..i18n import tr
 
 GROUPS = {
@@ -116,7 +116,7 @@ class TruOrthoAlgorithm(QgsProcessingAlgorithm):
         return self.GROUP_ID
 
     def shortHelpString(self) -> str:  # noqa: N802 - QGIS API
-        return help_html(self.NAME)
+        return help_text(self.NAME)
 
     def createInstance(self):  # noqa: N802 - QGIS API
         return type(self)()

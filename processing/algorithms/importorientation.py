@@ -94,7 +94,13 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
             )
         )
         self.add(
-            QgsProcessingParameterFeatureSink(self.CAMERAS, tr("Cameras"), QgsProcessing.TypeVectorPoint)
+            QgsProcessingParameterFeatureSink(
+                self.CAMERAS,
+                tr("Cameras"),
+                QgsProcessing.TypeVectorPoint,
+                optional=True,
+                createByDefault=True,
+            )
         )
         self.add(
             QgsProcessingParameterFeatureSink(
@@ -163,14 +169,13 @@ class ImportOrientationAlgorithm(TruOrthoAlgorithm):
         sink, cameras_id = self.parameterAsSink(
             parameters, self.CAMERAS, context, fields, QgsWkbTypes.PointZ, target
         )
-        if sink is None:
-            raise QgsProcessingException(self.invalidSinkError(parameters, self.CAMERAS))
         n = len(orientation.images)
-        for i, feat in enumerate(camera_features(orientation, fields)):
-            sink.addFeature(feat, QgsFeatureSink.FastInsert)
-            steps[2].update((i + 1) / n)
-
-        results = {self.OUTPUT: out, self.CAMERAS: cameras_id}
+        results = {self.OUTPUT: out}
+        if sink is not None:  # optional: skipped when not asked for (qgis_process, processing.run)
+            for i, feat in enumerate(camera_features(orientation, fields)):
+                sink.addFeature(feat, QgsFeatureSink.FastInsert)
+                steps[2].update((i + 1) / n)
+            results[self.CAMERAS] = cameras_id
         fsink, foot_id = self.parameterAsSink(
             parameters, self.FOOTPRINTS, context, footprint_fields(), QgsWkbTypes.PolygonZ, target
         )

@@ -30,6 +30,12 @@ from ..layers import camera_features, camera_fields, crs_text, ground_control, q
 from .base import FromConfig, TruOrthoAlgorithm
 
 
+def report_beside(orientation_json: str) -> str:
+    """Where the report goes when REPORT is not given: ``<orientation stem>_report.html`` beside it."""
+    stem, _ = os.path.splitext(orientation_json)
+    return stem + "_report.html"
+
+
 def tie_point_fields() -> QgsFields:
     fields = QgsFields()
     fields.append(QgsField("multiplicity", QVariant.Int))
@@ -126,10 +132,22 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
             )
         )
         self.add(
-            QgsProcessingParameterFileDestination(self.REPORT, tr("Report (HTML)"), tr("HTML files (*.html)"))
+            QgsProcessingParameterFileDestination(
+                self.REPORT,
+                tr("Report (HTML)"),
+                tr("HTML files (*.html)"),
+                optional=True,
+                createByDefault=True,
+            )
         )
         self.add(
-            QgsProcessingParameterFeatureSink(self.CAMERAS, tr("Cameras"), QgsProcessing.TypeVectorPoint)
+            QgsProcessingParameterFeatureSink(
+                self.CAMERAS,
+                tr("Cameras"),
+                QgsProcessing.TypeVectorPoint,
+                optional=True,
+                createByDefault=True,
+            )
         )
         self.add(
             QgsProcessingParameterFeatureSink(
@@ -167,6 +185,7 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
 
     @core_errors()
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 - QGIS API
+        from ...core.cache import cache_root
         from ...core.sfm.pipeline import OrientConfig, orient_images
 
         paths = self._image_paths(parameters, context)
@@ -187,14 +206,14 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
         )
         camera_file = self.parameterAsFile(parameters, self.CAMERA, context) or None
         out_json = self.parameterAsFileOutput(parameters, self.ORIENTATION, context)
-        out_html = self.parameterAsFileOutput(parameters, self.REPORT, context)
+        out_html = self.parameterAsFileOutput(parameters, self.REPORT, context) or report_beside(out_json)
         run = orient_images(
             paths,
             camera_file=camera_file,
             gcps=gcps,
             crs=crs_text(crs),
             config=cfg,
-            work_dir=os.path.join(os.path.dirname(os.path.abspath(out_json)), ".truortho-cache"),
+            work_dir=str(cache_root()),  # the per-user cache, never beside the products
             progress=FeedbackProgress(feedback),
         )
         for w in run.report.warnings:
@@ -214,11 +233,10 @@ class OrientImagesAlgorithm(TruOrthoAlgorithm):
         sink, cid = self.parameterAsSink(
             parameters, self.CAMERAS, context, fields, QgsWkbTypes.PointZ, target
         )
-        if sink is None:
-            raise QgsProcessingException(self.invalidSinkError(parameters, self.CAMERAS))
-        for f in camera_features(o, fields):
-            sink.addFeature(f, QgsFeatureSink.FastInsert)
-        results[self.CAMERAS] = cid
+        if sink is not None:  # optional: skipped when not asked for (qgis_process, processing.run)
+            for f in camera_features(o, fields):
+                sink.addFeature(f, QgsFeatureSink.FastInsert)
+            results[self.CAMERAS] = cid
         tfields = tie_point_fields()
         tsink, tid = self.parameterAsSink(
             parameters, self.TIE_POINTS, context, tfields, QgsWkbTypes.PointZ, target

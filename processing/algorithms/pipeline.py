@@ -157,6 +157,8 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         for row in run.stats["stages"]:
             feedback.pushInfo(tr("{}: {:.1f} s, peak {:.0f} MB; {}").format(row[0], row[1], row[2], row[3]))
         feedback.pushInfo(tr("Tiles ran on: {}").format(run.stats["executor"]))
+        for w in run.report.warnings if run.report is not None else []:  # also in report.html
+            feedback.pushWarning(w)
         results = {key: run.paths[prod] for key, prod in self.OUTPUTS.items()}
         results[self.OUTPUT_FOLDER] = out_folder
         self._load(context, results)

@@ -6,8 +6,6 @@ optional ``notes``. Texts go through ``tr()`` when shown.
 
 from __future__ import annotations
 
-from html import escape
-
 from ..i18n import tr
 
 #: Help of SCHEDULER_ADDRESS, the same for every tiled algorithm.
@@ -47,8 +45,8 @@ HELP: dict[str, dict] = {
             "FOOTPRINT_HEIGHT": "Height (in the CRS) of the plane the footprints are drawn on; default the "
             "median height of the sparse points, or of the GCPs, or 0.",
             "OUTPUT": "The orientation JSON (TruOrtho format, version 1).",
-            "CAMERAS": "Projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa "
-            "(degrees).",
+            "CAMERAS": "Optional: projection centres as PointZ with name, camera, x, y, z, omega, phi, kappa "
+            "(degrees); skipped when not given.",
             "FOOTPRINTS": "Image footprints on the horizontal plane at FOOTPRINT_HEIGHT.",
         },
     },
@@ -142,8 +140,10 @@ HELP: dict[str, dict] = {
             "ORIENTATION": "The adjusted orientation (TruOrtho JSON).",
             "REPORT": "HTML report (and a JSON file of the same name): sigma0, image RMS, per-image "
             "residuals, GCP and check point tables, residual vector plots, tie-point multiplicity "
-            "histogram, block overview.",
-            "CAMERAS": "Projection centres (PointZ) with omega, phi, kappa.",
+            "histogram, block overview. Optional: by default written beside ORIENTATION as "
+            "name_report.html.",
+            "CAMERAS": "Optional: projection centres (PointZ) with omega, phi, kappa; skipped when not "
+            "given.",
             "TIE_POINTS": "Tie points (PointZ) with multiplicity, mean reprojection error and colour.",
             "GCP_RESIDUALS": "GCPs and check points with dX, dY, dZ (adjusted or triangulated minus "
             "surveyed).",
@@ -184,7 +184,15 @@ HELP: dict[str, dict] = {
             "computed in QGIS's process. The address is checked before the orientation starts; the scheduler "
             "is first contacted by dense matching.",
             "SCHEDULER_ADDRESS": _SCHEDULER_HELP,
-            "OUTPUT_FOLDER": "Folder of the products (created when missing; existing products are replaced).",
+            "OUTPUT_FOLDER": "Folder of the products (created when missing; existing products are replaced). "
+            "It holds only products: orientation.json (adjusted orientation), report.html and report.json "
+            "(the quality report and its data), dsm_raw.tif (DSM as matched, before filtering), "
+            "confidence.tif (matching confidence 0 to 1), orthoimage.tif (colour of each DSM cell from the "
+            "matching, not a true orthophoto), dsm.tif (filtered DSM), pointcloud.laz, mesh.ply, "
+            "trueortho.tif, source_index.tif (which photo each true-orthophoto cell comes from), "
+            "occlusion.tif and seamlines.gpkg. Caches (compiled kernels, image features) are kept in "
+            "the per-user cache folder (environment variable TRUORTHO_CACHE_DIR; truortho:environment "
+            "shows and clears it).",
             "ORIENTATION": "orientation.json: the adjusted orientation.",
             "REPORT": "report.html (and report.json): the quality report of the run.",
             "DSM": "dsm.tif: the filtered DSM (float32, nodata -9999).",
@@ -416,7 +424,8 @@ HELP: dict[str, dict] = {
             "CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR "
             "describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An "
             "Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's "
-            "QGIS 3.22) open it as a point cloud layer (Layer > Add Layer > Point Cloud, choose ept.json)."
+            "QGIS 3.22) open it as a point cloud layer (menu Layer, Add Layer, Add Point Cloud Layer; "
+            "choose ept.json)."
         ),
         "parameters": {
             "INPUT": "DSM raster with a projected CRS.",
@@ -447,20 +456,22 @@ HELP: dict[str, dict] = {
 }
 
 
-def help_html(name: str) -> str:
+def help_text(name: str) -> str:
+    """The help of algorithm ``name`` as plain text, one paragraph per line.
+
+    ``qgis_process help`` prints ``shortHelpString()`` as it is, and the toolbox wraps each line
+    of it in ``<p>`` (QGIS's ``formatHelp``), so plain lines read well in both; the texts hold
+    no ``<``, ``>`` or ``&`` (tested), which the toolbox would take for markup.
+    """
     entry = HELP.get(name)
     if not entry:
         return ""
-    parts = [f"<p>{escape(tr(entry['summary']))}</p>"]
-    params = entry.get("parameters", {})
-    if params:
-        parts.append("<dl>")
-        for key, text in params.items():
-            parts.append(f"<dt><b>{escape(key)}</b></dt><dd>{escape(tr(text))}</dd>")
-        parts.append("</dl>")
+    lines = [tr(entry["summary"])]
+    for key, text in entry.get("parameters", {}).items():
+        lines.append(f"{key}: {tr(text)}")
     if entry.get("notes"):
-        parts.append(f"<p>{escape(tr(entry['notes']))}</p>")
-    return "".join(parts)
+        lines.append(tr(entry["notes"]))
+    return "\n".join(line.replace("\n", " ") for line in lines)
 
 
 def parameter_help(name: str, parameter: str) -> str:
