@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..report import Report, Table
+from .accuracy import check_point_notes, control_geometry, convergence_note
 
 
 def _plt():
@@ -78,6 +79,11 @@ def orientation_report(
     if georef is not None:
         rep.warnings += list(georef.warnings)
     rep.warnings += list(stats.get("warnings", []))
+    if bundle is not None:
+        note = convergence_note(bundle.converged, bundle.reason, bundle.n_iterations, bundle.cost_history)
+        if note:
+            rep.warnings.append(note)
+    check_notes = _check_notes(georef, centers_world, points_world, cameras)
 
     # per-image residual statistics
     reg_names = [n for n, r in zip(image_names, registered, strict=True) if r]
@@ -154,7 +160,12 @@ def orientation_report(
         )
     if georef is not None and georef.check_table:
         rep.tables.append(
-            _gcp_table("Check points (triangulated − surveyed)", georef.check_table, georef.check_rmse)
+            _gcp_table(
+                "Check points (triangulated − surveyed)",
+                georef.check_table,
+                georef.check_rmse,
+                " ".join(check_notes),
+            )
         )
 
     rep.data = {
@@ -179,6 +190,7 @@ def orientation_report(
         "gcp_rmse": {} if georef is None else georef.gcp_rmse,
         "check_points": [] if georef is None else georef.check_table,
         "check_rmse": {} if georef is None else georef.check_rmse,
+        "check_notes": check_notes,
         "multiplicity_histogram": np.bincount(multiplicity.astype(np.int64)).tolist()
         if len(multiplicity)
         else [],
@@ -187,7 +199,34 @@ def orientation_report(
     return rep
 
 
-def _gcp_table(title, rows, rmse) -> Table:
+def _check_notes(georef, centers_world, points_world, cameras) -> list[str]:
+    """The check-point explanation (:func:`.accuracy.check_point_notes`) of a georeferenced block."""
+    if georef is None or not georef.check_table:
+        return []
+    ctrl = georef.gcp_table
+    xyz = np.array([[r["x"], r["y"], r["z"]] for r in ctrl]).reshape(-1, 3)
+    sig = None
+    if ctrl and all("sigma_xy" in r for r in ctrl):
+        sig = np.array([[r["sigma_xy"], r["sigma_xy"], r["sigma_z"]] for r in ctrl])
+    return check_point_notes(
+        control_geometry(xyz, sig),
+        georef.check_rmse,
+        _gsd(centers_world, points_world, cameras),
+        len(georef.check_table),
+        {r["name"]: int(r["views"]) for r in ctrl},
+    )
+
+
+def _gsd(centers_world, points_world, cameras) -> float:
+    """Median ground sample distance, metres: camera height above the median tie point over f."""
+    if not len(centers_world) or not len(points_world) or not cameras:
+        return float("nan")
+    height = float(np.median(centers_world[:, 2]) - np.median(points_world[:, 2]))
+    f = float(np.median([c.fx for c in cameras]))
+    return height / f if height > 0 and f > 0 else float("nan")
+
+
+def _gcp_table(title, rows, rmse, note: str = "") -> Table:
     out = [
         [
             r["name"],
@@ -201,7 +240,7 @@ def _gcp_table(title, rows, rmse) -> Table:
     ]
     if rmse:
         out.append(["RMSE", rmse["x"], rmse["y"], rmse["z"], rmse["3d"], rmse["n"]])
-    return Table(title, ["name", "dX [m]", "dY [m]", "dZ [m]", "3D [m]", "images"], out)
+    return Table(title, ["name", "dX [m]", "dY [m]", "dZ [m]", "3D [m]", "images"], out, note)
 
 
 def _figures(rep, centers, points, mult, obs_xy, res, georef, cameras) -> None:
