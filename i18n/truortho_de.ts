@@ -1065,8 +1065,8 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="24" />
-            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
-            <translation>Importiert die Orientierung eines Bildverbands (innere und äußere Orientierung jedes Bildes, dünne Punktwolke) aus COLMAP-, Orthority- oder OpenSfM/ODM-Dateien in das Orientierungs-JSON von TruOrtho und schreibt einen Layer der Projektionszentren und einen Layer der Bildabdeckungen. Konventionen (Kameraachsen, Rotationen, Pixelursprung) werden beim Import umgerechnet; siehe README, 'Formats and conventions'.</translation>
+            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see docs/FORMATS.md.</source>
+            <translation>Importiert die Orientierung eines Bildverbands (innere und äußere Orientierung jedes Bildes, dünne Punktwolke) aus COLMAP-, Orthority- oder OpenSfM/ODM-Dateien in das Orientierungs-JSON von TruOrtho und schreibt einen Layer der Projektionszentren und einen Layer der Bildabdeckungen. Konventionen (Kameraachsen, Rotationen, Pixelursprung) werden beim Import umgerechnet; siehe docs/FORMATS.md.</translation>
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="32" />
@@ -1949,7 +1949,7 @@
             <translation>TruOrtho-Modell {} konnte nicht geladen werden</translation>
         </message>
         <message>
-            <location filename="../processing/styles.py" line="68" />
+            <location filename="../processing/styles.py" line="73" />
             <source>seen by no image</source>
             <translation>von keinem Bild gesehen</translation>
         </message>
@@ -2297,6 +2297,10 @@
             <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>Der Algorithmus {} ist in dieser Version nicht verfügbar.</translation>
+        </message>
+        <message>
+            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
+            <translation type="obsolete">Importiert die Orientierung eines Bildverbands (innere und äußere Orientierung jedes Bildes, dünne Punktwolke) aus COLMAP-, Orthority- oder OpenSfM/ODM-Dateien in das Orientierungs-JSON von TruOrtho und schreibt einen Layer der Projektionszentren und einen Layer der Bildabdeckungen. Konventionen (Kameraachsen, Rotationen, Pixelursprung) werden beim Import umgerechnet; siehe README, 'Formats and conventions'.</translation>
         </message>
         <message>
             <source>Keep the measurements as a table layer in the project</source>

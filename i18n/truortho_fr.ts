@@ -1065,8 +1065,8 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="24" />
-            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
-            <translation>Importe l'orientation d'un bloc d'images (orientation interne et externe de chaque image, points épars) depuis des fichiers COLMAP, Orthority ou OpenSfM/ODM dans le JSON d'orientation de TruOrtho, et écrit une couche des centres de projection et une couche des emprises des images. Les conventions (axes de la caméra, rotations, origine des pixels) sont converties à l'import ; voir le README, 'Formats and conventions'.</translation>
+            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see docs/FORMATS.md.</source>
+            <translation>Importe l'orientation d'un bloc d'images (orientation interne et externe de chaque image, points épars) depuis des fichiers COLMAP, Orthority ou OpenSfM/ODM dans le JSON d'orientation de TruOrtho, et écrit une couche des centres de projection et une couche des emprises des images. Les conventions (axes de la caméra, rotations, origine des pixels) sont converties à l'import ; voir docs/FORMATS.md.</translation>
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="32" />
@@ -1949,7 +1949,7 @@
             <translation>Le modèle TruOrtho {} n'a pas pu être chargé</translation>
         </message>
         <message>
-            <location filename="../processing/styles.py" line="68" />
+            <location filename="../processing/styles.py" line="73" />
             <source>seen by no image</source>
             <translation>vu par aucune image</translation>
         </message>
@@ -2297,6 +2297,10 @@
             <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>L'algorithme {} n'est pas disponible dans cette version.</translation>
+        </message>
+        <message>
+            <source>Imports the orientation of an image block (interior and exterior orientation of every image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's orientation JSON, and writes a layer of projection centres and a layer of image footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; see the README, 'Formats and conventions'.</source>
+            <translation type="obsolete">Importe l'orientation d'un bloc d'images (orientation interne et externe de chaque image, points épars) depuis des fichiers COLMAP, Orthority ou OpenSfM/ODM dans le JSON d'orientation de TruOrtho, et écrit une couche des centres de projection et une couche des emprises des images. Les conventions (axes de la caméra, rotations, origine des pixels) sont converties à l'import ; voir le README, 'Formats and conventions'.</translation>
         </message>
         <message>
             <source>Keep the measurements as a table layer in the project</source>

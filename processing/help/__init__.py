@@ -25,7 +25,7 @@ HELP: dict[str, dict] = {
             "image, sparse points) from COLMAP, Orthority or OpenSfM/ODM files into TruOrtho's "
             "orientation JSON, and writes a layer of projection centres and a layer of image "
             "footprints. Conventions (camera axes, rotations, pixel origin) are converted at import; "
-            "see the README, 'Formats and conventions'."
+            "see docs/FORMATS.md."
         ),
         "parameters": {
             "INPUT": (
