@@ -5,7 +5,7 @@ local offset, interior orientations (:class:`~.geometry.camera.Camera`),
 exterior orientations (:class:`Image`), optional sparse tie points and
 ground control (:class:`GCP`). Conventions: :mod:`truortho.core.geometry`.
 
-JSON format ``truortho-orientation`` version 1 (documented in README)::
+JSON format ``truortho-orientation`` version 1 (documented in docs/FORMATS.md)::
 
     {
       "format": "truortho-orientation", "version": 1,
