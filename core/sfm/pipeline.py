@@ -22,6 +22,7 @@ import math
 import os
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -232,49 +233,82 @@ def decimation_cell(max_size_px: float, n_images: int) -> float:
     return max(float(max_size_px) / math.sqrt(cells), 8.0)
 
 
-def orient_images(
-    paths,
-    camera_file=None,
-    gcps: list[GCP] | None = None,
-    crs: str | None = None,
-    config: OrientConfig | None = None,
-    work_dir=None,
-    progress: Progress | None = None,
-) -> OrientationRun:
-    """Orient a block of images (see the module docstring).
+@dataclass(frozen=True)
+class OrientInputs:
+    """Stage 1 of :func:`orient_images`: the images, their EXIF and camera priors.
 
-    Parameters
-    ----------
-    paths : list of path
-        Image files (other files are skipped with a warning).
-    camera_file : path, optional
-        Orthority interior file (YAML/JSON) or a 3x3 K matrix text file.
-    gcps : list of GCP, optional
-        World coordinates in ``crs``, with image measurements by image file name.
-    crs : str, optional
-        CRS of the GCPs and the output (default: the UTM zone of EXIF GNSS, else none).
-    work_dir : path, optional
-        Feature cache.
+    ``paths``/``infos``/``names``/``exifs`` of the N image files kept; ``cams`` the camera models
+    and ``image_camera`` (N,) the camera of every image; ``crs`` the checked CRS text (or None).
+    """
+
+    paths: list[str]
+    infos: list
+    names: list[str]
+    exifs: list
+    cams: Any
+    image_camera: np.ndarray
+    cam_info: Any
+    crs: str | None
+
+
+@dataclass(frozen=True)
+class OrientMatches:
+    """Stages 2-3: features of every image, the pairs tried and their verified matches."""
+
+    features: Any
+    feature_stats: dict
+    cache: str | None
+    selection: Any
+    results: list
+    match_stats: dict
+    n_verified: int
+    sizes: np.ndarray
+    per_image_cams: list
+
+
+@dataclass(frozen=True)
+class OrientReconstruction:
+    """Stages 4-5: the tracks of the model and the incremental reconstruction.
+
+    ``matches``/``n_verified`` include a second matching pass for unregistered images;
+    ``refine`` the intrinsics the adjustment refines.
+    """
+
+    rec: Any
+    tracks: Any
+    results: list
+    n_verified: int
+    refine: tuple
+
+
+@dataclass(frozen=True)
+class OrientGeoref:
+    """Stage 6: the block adjusted in its frame (GCPs, GNSS, or free), with its offset and CRS."""
+
+    block: Block
+    track_ids: np.ndarray
+    georef_config: GeorefConfig
+    offset: np.ndarray
+    gps_local: np.ndarray | None
+    geo: Any
+    bundle: Any
+    crs: str | None
+
+
+def read_inputs(paths, camera_file, gcps: list[GCP], crs, warnings: list[str], step, prog) -> OrientInputs:
+    """Inventory, GCP names, EXIF and camera priors (stage 1 of :func:`orient_images`).
+
+    Raises
+    ------
+    InputError
+        Duplicate file names, GCPs without a CRS, a non-metric CRS, unreadable priors.
     """
     from ..exif import read_exif
-    from .features import FeatureConfig, extract_all
-    from .matching import match_pairs
-    from .pairs import PairConfig, select_pairs
-    from .tracks import tracks_from_pairs
 
-    cfg = config or OrientConfig()
-    prog = as_progress(progress)
-    steps = Steps(prog, [1, 10, 10, 1, 8, 3, 1])
-    t_start = time.perf_counter()
-    times: dict[str, float] = {}
-    warnings: list[str] = []
-    gcps = list(gcps or [])
     if crs is not None:
         pc = parse_crs(crs)
         require_metric(pc, "CRS")
         crs = crs_to_text(pc)
-
-    t = time.perf_counter()
     paths, infos = _inventory(list(paths), warnings)
     names = [os.path.basename(p) for p in paths]
     if len(set(names)) != len(names):
@@ -286,23 +320,40 @@ def orient_images(
     exifs = []
     for k, p in enumerate(paths):
         check(prog)
-        steps[0].update(k / len(paths), "reading EXIF")
+        step.update(k / len(paths), "reading EXIF")
         exifs.append(read_exif(p))
     cams, image_camera, cam_info = _camera_priors(paths, infos, exifs, camera_file, warnings)
-    times["inventory"] = time.perf_counter() - t
+    return OrientInputs(paths, infos, names, exifs, cams, image_camera, cam_info, crs)
+
+
+def match_images(inputs: OrientInputs, cfg: OrientConfig, work_dir, steps, times: dict) -> OrientMatches:
+    """SIFT features (cached in ``work_dir``), pair selection and verified matches (stages 2-3).
+
+    ``steps`` are the features' and the matching's progress steps; ``times`` gets their wall times.
+
+    Raises
+    ------
+    InputError
+        No pair could be matched.
+    """
+    from .features import FeatureConfig, extract_all
+    from .matching import match_pairs
+    from .pairs import PairConfig, select_pairs
 
     t = time.perf_counter()
     fcfg = FeatureConfig(max_dimension=cfg.working_size, max_features=cfg.max_features)
     cache = os.path.join(work_dir, "features") if work_dir else None
-    features, fstats = extract_all(paths, fcfg, cache, steps[1])
+    features, fstats = extract_all(inputs.paths, fcfg, cache, steps[0])
     times["features"] = time.perf_counter() - t
 
     t = time.perf_counter()
-    sizes = np.array([[i.width, i.height] for i in infos])
-    focals = np.array([cams[c].fx for c in image_camera])
-    sel = select_pairs(paths, exifs, sizes, focals, PairConfig(strategy=cfg.pair_strategy), cache, None)
-    per_image_cams = [cams[c] for c in image_camera]
-    results, mstats = match_pairs(features, sel.pairs, per_image_cams, progress=steps[2])
+    sizes = np.array([[i.width, i.height] for i in inputs.infos])
+    focals = np.array([inputs.cams[c].fx for c in inputs.image_camera])
+    sel = select_pairs(
+        inputs.paths, inputs.exifs, sizes, focals, PairConfig(strategy=cfg.pair_strategy), cache, None
+    )
+    per_image_cams = [inputs.cams[c] for c in inputs.image_camera]
+    results, mstats = match_pairs(features, sel.pairs, per_image_cams, progress=steps[1])
     n_verified = sum(r.ok for r in results)
     times["matching"] = time.perf_counter() - t
     if n_verified == 0:
@@ -310,11 +361,38 @@ def orient_images(
             "IMAGES: no image pair could be matched; the images do not overlap "
             f"({sel.n_pairs} pairs tried, strategy {sel.strategy})"
         )
+    return OrientMatches(features, fstats, cache, sel, results, mstats, n_verified, sizes, per_image_cams)
 
+
+def reconstruct_block(
+    inputs: OrientInputs,
+    matches: OrientMatches,
+    cfg: OrientConfig,
+    camera_file,
+    warnings: list[str],
+    steps,
+    prog,
+    times: dict,
+) -> OrientReconstruction:
+    """Tracks, incremental reconstruction and a second matching pass for left-out images (stages 4-5).
+
+    ``steps`` are the tracks' and the reconstruction's progress steps. Sets the intrinsics that
+    ``cfg.incremental`` refines (a given camera file is a calibration, kept fixed).
+
+    Raises
+    ------
+    InputError
+        Fewer than two images registered.
+    """
+    from .matching import match_pairs
+    from .tracks import tracks_from_pairs
+
+    paths, names, image_camera, cams = inputs.paths, inputs.names, inputs.image_camera, inputs.cams
+    features, results, n_verified = matches.features, matches.results, matches.n_verified
     t = time.perf_counter()
-    cell = cfg.decimation_cell_px or decimation_cell(float(sizes.max()), len(paths))
+    cell = cfg.decimation_cell_px or decimation_cell(float(matches.sizes.max()), len(paths))
     tracks = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)
-    steps[3].update(1.0, f"{tracks.n_tracks} tie points after decimation")
+    steps[0].update(1.0, f"{tracks.n_tracks} tie points after decimation")
     times["tracks"] = time.perf_counter() - t
 
     t = time.perf_counter()
@@ -330,9 +408,10 @@ def orient_images(
     elif camera_file:
         inc.refine_focal_early = False
     rec = reconstruct(
-        tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, steps[4], features, tracks.feature
+        tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, steps[1], features, tracks.feature
     )
     missing = np.flatnonzero(~rec.registered)
+    sel = matches.selection
     if len(missing) and sel.strategy != "exhaustive" and rec.registered.sum() >= 2:
         # second chance: match the images left out against every image not paired with them yet
         tried = {(int(a), int(b)) for a, b in sel.pairs}
@@ -344,7 +423,7 @@ def orient_images(
             prog.update(
                 0.85, f"matching {len(missing)} unregistered image(s) against all others ({len(extra)} pairs)"
             )
-            more, _ = match_pairs(features, np.array(extra), per_image_cams)
+            more, _ = match_pairs(features, np.array(extra), matches.per_image_cams)
             results = results + more
             n_verified = sum(r.ok for r in results)
             tracks2 = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)
@@ -361,10 +440,10 @@ def orient_images(
             )
             if rec2.registered.sum() > rec.registered.sum():
                 rec, tracks = rec2, tracks2
-            stats_extra = {"second_pass_pairs": len(extra), "registered_after": int(rec.registered.sum())}
+            registered_after = int(rec.registered.sum())
             warnings.append(
                 f"second matching pass for {len(missing)} image(s): {len(extra)} more pairs, "
-                f"{stats_extra['registered_after']} images registered"
+                f"{registered_after} images registered"
             )
     times["reconstruction"] = time.perf_counter() - t
     n_reg = int(rec.registered.sum())
@@ -375,21 +454,37 @@ def orient_images(
     warnings += _guided_messages(rec.stats.get("guided", []), names)
     # the observations of the model: the tracks plus the matches added by guided registration
     tracks = _model_tracks(tracks, rec)
+    return OrientReconstruction(rec, tracks, results, n_verified, refine)
 
-    t = time.perf_counter()
+
+def georeference_block(
+    inputs: OrientInputs,
+    r: OrientReconstruction,
+    gcps: list[GCP],
+    cfg: OrientConfig,
+    warnings: list[str],
+    step,
+) -> OrientGeoref:
+    """The block in its frame: GCPs, else EXIF GNSS, else free (stage 6 of :func:`orient_images`).
+
+    The local offset is chosen from the GCPs or the GNSS positions; without usable control the
+    block is adjusted free, in an arbitrary frame without CRS (and a warning).
+    """
+    rec, tracks = r.rec, r.tracks
     block, track_ids = block_from_reconstruction(
-        rec, tracks.track, tracks.image, tracks.xy, names, cams, image_camera
+        rec, tracks.track, tracks.image, tracks.xy, inputs.names, inputs.cams, inputs.image_camera
     )
     gcfg = cfg.georef
-    gcfg.refine_intrinsics = refine if cfg.self_calibration else ()
-    gps_world, crs = _gps_local(exifs, crs, warnings) if not gcps else (None, crs)
+    gcfg.refine_intrinsics = r.refine if cfg.self_calibration else ()
+    crs = inputs.crs
+    gps_world, crs = _gps_local(inputs.exifs, crs, warnings) if not gcps else (None, crs)
     offset = np.zeros(3)
     if gcps:
         offset = choose_offset(np.array([g.xyz for g in gcps]))
     elif gps_world is not None:
         offset = choose_offset(gps_world[np.all(np.isfinite(gps_world), axis=1)])
     gps_local = None if gps_world is None else (gps_world - offset)[rec.registered]
-    geo = georeference(block, gcps, offset, gps_local, gcfg, steps[5])
+    geo = georeference(block, gcps, offset, gps_local, gcfg, step)
     if geo.method == "none":
         bundle = _adjust_free(block, gcfg)
         crs_out = None
@@ -401,6 +496,56 @@ def orient_images(
     else:
         bundle = geo.bundle
         crs_out = crs
+    return OrientGeoref(block, track_ids, gcfg, offset, gps_local, geo, bundle, crs_out)
+
+
+def orient_images(
+    paths,
+    camera_file=None,
+    gcps: list[GCP] | None = None,
+    crs: str | None = None,
+    config: OrientConfig | None = None,
+    work_dir=None,
+    progress: Progress | None = None,
+) -> OrientationRun:
+    """Orient a block of images (see the module docstring).
+
+    The stages: :func:`read_inputs` -> :func:`match_images` -> :func:`reconstruct_block` ->
+    :func:`georeference_block`, then the orientation, the tie points and the report.
+
+    Parameters
+    ----------
+    paths : list of path
+        Image files (other files are skipped with a warning).
+    camera_file : path, optional
+        Orthority interior file (YAML/JSON) or a 3x3 K matrix text file.
+    gcps : list of GCP, optional
+        World coordinates in ``crs``, with image measurements by image file name.
+    crs : str, optional
+        CRS of the GCPs and the output (default: the UTM zone of EXIF GNSS, else none).
+    work_dir : path, optional
+        Feature cache.
+    """
+    cfg = config or OrientConfig()
+    prog = as_progress(progress)
+    steps = Steps(prog, [1, 10, 10, 1, 8, 3, 1])
+    t_start = time.perf_counter()
+    times: dict[str, float] = {}
+    warnings: list[str] = []
+    gcps = list(gcps or [])
+    t = time.perf_counter()
+    inputs = read_inputs(paths, camera_file, gcps, crs, warnings, steps[0], prog)
+    times["inventory"] = time.perf_counter() - t
+    paths, names, cam_info = inputs.paths, inputs.names, inputs.cam_info
+    m = match_images(inputs, cfg, work_dir, (steps[1], steps[2]), times)
+    features, fstats, sel, mstats = m.features, m.feature_stats, m.selection, m.match_stats
+    r = reconstruct_block(inputs, m, cfg, camera_file, warnings, (steps[3], steps[4]), prog, times)
+    rec, tracks, n_verified = r.rec, r.tracks, r.n_verified
+    n_reg = int(rec.registered.sum())
+
+    t = time.perf_counter()
+    g = georeference_block(inputs, r, gcps, cfg, warnings, steps[5])
+    block, track_ids, offset, geo, bundle, crs_out = g.block, g.track_ids, g.offset, g.geo, g.bundle, g.crs
     times["georeferencing"] = time.perf_counter() - t
 
     orientation, tie = _build_orientation(
