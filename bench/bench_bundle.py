@@ -11,7 +11,7 @@ f, cx, cy, k1, k2, p1, p2 by TruOrtho and by pycolmap's Ceres bundle
 adjuster (OPENCV camera model, +0.5 px principal point / observation shift,
 same perturbed start, gauge: TruOrtho's minimal constraints vs COLMAP's
 TWO_CAMS_FROM_WORLD). Each engine runs in its own subprocess so the peak
-resident memory (``resource.getrusage``) is its own.
+resident memory (``core.memory.peak_rss_mb``) is its own.
 """
 
 from __future__ import annotations
@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import resource
 import subprocess
 import sys
 import tempfile
@@ -91,7 +90,10 @@ def make_problem(n_images: int, n_points: int, seed: int = 0) -> dict:
 
 
 def _rss_mb() -> float:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    from truortho.core.memory import peak_rss_mb  # the one peak-memory helper (kB/bytes/Windows)
+
+    peak = peak_rss_mb()
+    return float("nan") if peak is None else peak
 
 
 def run_ours(d: dict) -> dict:

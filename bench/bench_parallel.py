@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import resource
 import sys
 import tempfile
 import time
@@ -45,7 +44,10 @@ import numpy as np
 
 
 def _maxrss_mb() -> float:
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    from truortho.core.memory import peak_rss_mb  # the one peak-memory helper (kB/bytes/Windows)
+
+    peak = peak_rss_mb()
+    return float("nan") if peak is None else peak
 
 
 def _peak_rss_mb() -> float:
