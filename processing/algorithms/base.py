@@ -100,8 +100,24 @@ class TruOrthoAlgorithm(QgsProcessingAlgorithm):
     OWN_DEFAULTS: dict[str, str] = {}
 
     def default(self, name: str) -> Any:
-        """Default of parameter ``name``: its config field's default (``CONFIG_DEFAULTS``)."""
-        return self.CONFIG_DEFAULTS[name].value()
+        """Default of parameter ``name``: its config field's default (``CONFIG_DEFAULTS``).
+
+        Reading it imports the config's core module. When a package that module needs is missing
+        (numba, OpenCV, ...) the parameter gets no default and :meth:`canExecute` names the
+        package: an exception here, during the provider's registration, would abort QGIS.
+        """
+        try:
+            return self.CONFIG_DEFAULTS[name].value()
+        except ImportError as exc:
+            self._missing = str(exc)
+            return None
+
+    def canExecute(self):  # noqa: N802 - QGIS API
+        """False with the reason when the defaults could not be read (a missing package)."""
+        missing = getattr(self, "_missing", None)
+        if missing:
+            return False, tr("TruOrtho algorithms could not be loaded: {}").format(missing)
+        return True, ""
 
     def name(self) -> str:
         return self.NAME

@@ -109,3 +109,23 @@ def test_a_hand_written_default_is_caught(qgis_processing_ready):
     alg = Unlisted()
     alg.initAlgorithm()
     assert mismatches(alg) == ["dsmfilter.EXECUTOR: in 0 of CONFIG_DEFAULTS/OWN_DEFAULTS (expected 1)"]
+
+
+def test_a_missing_package_leaves_the_algorithm_loadable(qgis_processing_ready):
+    """An ImportError while reading a default must not escape initAlgorithm (it would abort QGIS)."""
+    from truortho.processing.algorithms.base import FromConfig
+    from truortho.processing.algorithms.dsmfilter import DsmFilterAlgorithm
+
+    class Missing(DsmFilterAlgorithm):
+        CONFIG_DEFAULTS = {
+            **DsmFilterAlgorithm.CONFIG_DEFAULTS,
+            "MAX_HOLE": FromConfig("no_such_module.DsmFilterConfig", "max_hole"),
+        }
+
+    alg = Missing()
+    alg.initAlgorithm()
+    assert alg.parameterDefinition("MAX_HOLE").defaultValue() is None
+    assert alg.parameterDefinition("SLOPE").defaultValue() == 0.15  # the others are read
+    ok, message = alg.canExecute()
+    assert not ok and "no_such_module" in message
+    assert DsmFilterAlgorithm().canExecute() == (True, "")
