@@ -300,7 +300,7 @@ class PointCloudFile:
     ) -> None:
         from ..rasterio_io import PointCloudWriter
 
-        dims = {}
+        dims: dict[str, np.dtype] = {}
         if confidence:
             dims[CONFIDENCE] = np.dtype(np.float32)
         if system:
