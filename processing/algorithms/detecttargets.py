@@ -62,7 +62,11 @@ class DetectTargetsAlgorithm(TruOrthoAlgorithm):
     }
 
     def initAlgorithm(self, config=None):  # noqa: N802 - QGIS API
-        from ...core.gcp.targets import ARUCO_DICTIONARIES
+        try:  # needs OpenCV: without it the algorithm says so (canExecute) instead of aborting QGIS
+            from ...core.gcp.targets import ARUCO_DICTIONARIES
+        except ImportError as exc:
+            self._missing = str(exc)
+            ARUCO_DICTIONARIES = ("DICT_4X4_50",)  # noqa: N806 - the name of the real table
 
         self.add(
             QgsProcessingParameterFile(

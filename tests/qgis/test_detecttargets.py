@@ -153,3 +153,18 @@ def test_table_sigmas_become_measurement_weights(truortho_provider, folder, tmp_
     mem.dataProvider().addFeatures([f])
     with pytest.raises(QgsProcessingException, match="sigma must be positive"):
         read_observation_table(mem, [GCP("G0", [0.0, 0.0, 0.0])])
+
+
+def test_without_opencv_the_algorithm_says_so_instead_of_failing(monkeypatch, qgis_processing_ready):
+    """Registering the algorithm must not raise when OpenCV is missing (an exception while the
+    provider loads aborts QGIS): it loads, and canExecute names the missing package."""
+    import sys
+
+    from truortho.processing.algorithms.detecttargets import DetectTargetsAlgorithm
+
+    monkeypatch.setitem(sys.modules, "truortho.core.gcp.targets", None)  # import -> ImportError
+    alg = DetectTargetsAlgorithm()
+    alg.initAlgorithm()
+    ok, why = alg.canExecute()
+    assert not ok and why
+    assert alg.parameterDefinition("DICTIONARY") is not None
