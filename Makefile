@@ -33,12 +33,14 @@ demo: setup
 # (pycolmap, OpenCV, Orthority) measured in the same run. make bench BENCH=bundle runs one.
 # The scale bench (hours at its defaults: 50 to 400 photos of 12 MP) runs only when named:
 # make bench BENCH=scale BENCH_ARGS="--sizes 25,50,100 --megapixels 3 --resolution 0.25 --write-docs"
+# Each bench writes what it printed into its section of docs/benchmarks.md (BENCH_DOCS= to skip).
 BENCH ?= *
+BENCH_DOCS ?= --write-docs
 bench: setup
 	$(ENV) $(PY) -m pip install -q -r requirements-bench.txt -c constraints.txt
 	@for f in bench/bench_$(BENCH).py; do \
 	  case "$$f" in *bench_scale.py) [ "$(BENCH)" = scale ] || continue;; esac; \
-	  echo "== $$f"; $(ENV) $(PY) -P $$f $(BENCH_ARGS) || exit 1; done
+	  echo "== $$f"; $(ENV) $(PY) -P $$f $(BENCH_ARGS) $(BENCH_DOCS) || exit 1; done
 
 # Randomized acceptance battery (not a test; about half an hour on 2 cores): DSM and true ortho on 12
 # synthetic cities drawn from wide ranges, against their truth and a pairwise OpenCV SGBM baseline.

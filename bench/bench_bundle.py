@@ -265,4 +265,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from _docs import run_main
+
+    TITLE = "Bundle adjustment against pycolmap (Ceres)"
+    sys.exit(run_main(main, "bundle", TITLE, peers=("pycolmap",)))

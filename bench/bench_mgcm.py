@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import argparse
 import math
+import os
+import sys
 import time
 
 import cv2
@@ -296,4 +298,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from _docs import run_main
+
+    TITLE = "Target detection and least-squares matching (MGCM)"
+    sys.exit(run_main(main, "mgcm", TITLE, peers=("cv2",)))

@@ -503,4 +503,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from _docs import run_main
+
+    TITLE = "Orientation against pycolmap"
+    sys.exit(run_main(main, "orientation", TITLE, peers=("pycolmap", "cv2")))

@@ -35,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 import tempfile
 import time
@@ -269,4 +270,8 @@ def _save(results: dict) -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from _docs import run_main
+
+    TITLE = "Scale-out: in-process against a local Dask cluster"
+    sys.exit(run_main(main, "parallel", TITLE, peers=("dask", "distributed")))

@@ -30,7 +30,6 @@ import argparse
 import json
 import math
 import os
-import platform
 import shutil
 import subprocess
 import sys
@@ -321,33 +320,17 @@ def main(argv=None) -> int:
     with open(os.path.join(HERE, "results", "scale.json"), "w") as fh:
         json.dump(rows, fh, indent=1)
     if args.write_docs:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                                text=True).stdout.strip()  # fmt: skip
-        argv = sys.argv[1:]
+        sys.path.insert(0, HERE)
+        from _docs import header, write_section
+
+        argv = [a for a in sys.argv[1:] if a != "--write-docs"]
         if "--keep" in argv:  # a local folder, not part of what is measured
             k = argv.index("--keep")
             argv = argv[:k] + argv[k + 2 :]
         argv = [a for a in argv if not a.startswith("--keep=")]
         cmd = 'make bench BENCH=scale BENCH_ARGS="' + " ".join(argv) + '"'
-        block = [f"Command: `{cmd}` at commit {commit}, {time.strftime('%Y-%m-%d')}, "
-                 f"{os.cpu_count()} cores, {platform.machine()}.", ""] + lines  # fmt: skip
-        write_section(DOCS, "scale", block)
+        write_section("scale", "Scale: photos to true ortho", [header(cmd), "", *lines])
     return 0
-
-
-def write_section(path: str, key: str, lines: list[str]) -> None:
-    """Replace the text between ``<!-- key:begin -->`` and ``<!-- key:end -->`` (appended when missing)."""
-    begin, end = f"<!-- {key}:begin -->", f"<!-- {key}:end -->"
-    text = open(path).read() if os.path.exists(path) else "# Benchmarks\n"
-    body = "\n".join([begin, *lines, end])
-    if begin in text and end in text:
-        text = text[: text.index(begin)] + body + text[text.index(end) + len(end) :]
-    else:
-        text = text.rstrip("\n") + "\n\n## Scale: photos to true ortho\n\n" + body + "\n"
-    tmp = path + ".part"
-    with open(tmp, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
 
 
 if __name__ == "__main__":

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import time
 
 import numpy as np
@@ -145,4 +146,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from _docs import run_main
+
+    TITLE = "SGM kernels against OpenCV"
+    sys.exit(run_main(main, "sgm", TITLE, peers=("cv2",)))

@@ -21,6 +21,8 @@ Wall times on a shared machine are indicative only.
 from __future__ import annotations
 
 import argparse
+import os
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -186,4 +188,8 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from _docs import run_main
+
+    TITLE = "Surface products against simple peers"
+    sys.exit(run_main(main, "surface", TITLE, peers=("scipy", "rasterio")))

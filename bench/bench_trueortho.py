@@ -405,4 +405,8 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from _docs import run_main
+
+    TITLE = "True orthophoto against Orthority"
+    sys.exit(run_main(main, "trueortho", TITLE, peers=("orthority",)))
