@@ -68,6 +68,10 @@ class OrientConfig:
     min_pair_tracks: int = 150
     #: Pair selection strategy: auto, exhaustive, gps, retrieval.
     pair_strategy: str = "auto"
+    #: Refine the tie-point observations by least-squares matching against a master image at the
+    #: working resolution after the adjustment, then adjust again (:mod:`truortho.core.gcp.tiepoints`;
+    #: keeps every registered image's grey working image in memory).
+    refine_tie_points: bool = False
     incremental: IncrementalConfig = field(default_factory=IncrementalConfig)
     georef: GeorefConfig = field(default_factory=GeorefConfig)
 
@@ -546,7 +550,15 @@ def orient_images(
     t = time.perf_counter()
     g = georeference_block(inputs, r, gcps, cfg, warnings, steps[5])
     block, track_ids, offset, geo, bundle, crs_out = g.block, g.track_ids, g.offset, g.geo, g.bundle, g.crs
+    gcfg, gps_local = g.georef_config, g.gps_local
     times["georeferencing"] = time.perf_counter() - t
+    tie_refinement = None
+    if cfg.refine_tie_points and len(block.obs_xy):
+        t = time.perf_counter()
+        tie_refinement, bundle, geo = _refine_and_readjust(
+            block, paths, cfg, bundle, geo, gcps, offset, gps_local, gcfg, prog
+        )
+        times["tie refinement"] = time.perf_counter() - t
 
     orientation, tie = _build_orientation(
         block, track_ids, tracks, features, bundle, paths, rec, crs_out, offset, gcps
@@ -576,6 +588,8 @@ def orient_images(
         "cameras": cam_info,
         "warnings": warnings,
     }
+    if tie_refinement is not None:
+        stats["tie_refinement"] = tie_refinement
     reg_idx = np.flatnonzero(rec.registered)
     rep = orientation_report(
         "TruOrtho orientation report",
@@ -628,6 +642,45 @@ def _guided_messages(entries: list[dict], names: list[str]) -> list[str]:
             f"{e['rms_px']:.2f} px"
         )
     return out
+
+
+def _refine_and_readjust(
+    block: Block, paths, cfg: OrientConfig, bundle, geo, gcps, offset, gps_local, gcfg, prog
+):
+    """LSM refinement of the tie-point observations, then the same adjustment again.
+
+    Returns (statistics with the figures before and after, bundle, georeferencing result).
+    """
+    from ..gcp.tiepoints import refine_tie_points
+    from ..imagery import image_info, luminance, read_image, scaled_size
+
+    by_name = {os.path.basename(p): p for p in paths}
+    images, scales = [], []
+    for k, name in enumerate(block.image_names):
+        check(prog)
+        prog.update(0.97, f"tie refinement: reading {name} ({k + 1} of {len(block.image_names)})")
+        info = image_info(by_name[name])
+        s = min(1.0, cfg.working_size / max(info.width, info.height))
+        _, _, sx, sy = scaled_size(info.width, info.height, s)
+        images.append(luminance(read_image(by_name[name], scale=s)))
+        scales.append((sx, sy))
+    before = {"sigma0": float(bundle.sigma0), "check_rmse": dict(geo.check_rmse)}
+    ref = refine_tie_points(block, images, np.array(scales))
+    del images
+    block.obs_xy = ref.obs_xy
+    if geo.method == "none":
+        bundle = _adjust_free(block, gcfg)
+    else:
+        geo = georeference(block, gcps, offset, gps_local, gcfg)
+        bundle = geo.bundle
+    stats = {
+        **ref.stats,
+        "sigma0_before": before["sigma0"],
+        "sigma0_after": float(bundle.sigma0),
+        "check_rmse_before": before["check_rmse"],
+        "check_rmse_after": dict(geo.check_rmse),
+    }
+    return stats, bundle, geo
 
 
 def _adjust_free(block: Block, gcfg: GeorefConfig):
