@@ -24,37 +24,42 @@
             <translation>Werkzeuge</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="145" />
+            <location filename="../processing/algorithms/base.py" line="161" />
             <source>Run tiles on</source>
             <translation>Kacheln ausführen auf</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="158" />
+            <location filename="../processing/algorithms/base.py" line="174" />
             <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
             <translation>Adresse des Dask-Schedulers (tls://host:port oder Scheduler-Datei; leer = TRUORTHO_DASK_SCHEDULER)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="178" />
+            <location filename="../processing/algorithms/base.py" line="194" />
             <source>Ground control points</source>
             <translation>Passpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="184" />
+            <location filename="../processing/algorithms/base.py" line="200" />
             <source>GCP image measurements (table)</source>
             <translation>Bildmessungen der Passpunkte (Tabelle)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="147" />
+            <location filename="../processing/algorithms/base.py" line="119" />
+            <source>TruOrtho algorithms could not be loaded: {}</source>
+            <translation>TruOrtho-Algorithmen konnten nicht geladen werden: {}</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/base.py" line="163" />
             <source>inprocess: this process (all cores)</source>
             <translation>inprocess: dieser Prozess (alle Kerne)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="148" />
+            <location filename="../processing/algorithms/base.py" line="164" />
             <source>local: a Dask cluster of worker processes on this computer</source>
             <translation>local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="149" />
+            <location filename="../processing/algorithms/base.py" line="165" />
             <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
             <translation>scheduler: ein Dask-Scheduler (SCHEDULER_ADDRESS)</translation>
         </message>
@@ -64,92 +69,92 @@
             <translation>Bodenmarken erkennen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="69" />
+            <location filename="../processing/algorithms/detecttargets.py" line="73" />
             <source>Image folder</source>
             <translation>Bildordner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="75" />
+            <location filename="../processing/algorithms/detecttargets.py" line="79" />
             <source>Target type</source>
             <translation>Markentyp</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="83" />
+            <location filename="../processing/algorithms/detecttargets.py" line="87" />
             <source>ArUco dictionary</source>
             <translation>ArUco-Wörterbuch</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="90" />
+            <location filename="../processing/algorithms/detecttargets.py" line="94" />
             <source>Marker IDs -&gt; GCP names (e.g. 0=GCP1,1=GCP2)</source>
             <translation>Marker-IDs -&gt; Passpunktnamen (z. B. 0=GCP1,1=GCP2)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="95" />
+            <location filename="../processing/algorithms/detecttargets.py" line="99" />
             <source>Orientation (TruOrtho JSON)</source>
             <translation>Orientierung (TruOrtho-JSON)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="106" />
+            <location filename="../processing/algorithms/detecttargets.py" line="110" />
             <source>Search radius around predicted positions (px)</source>
             <translation>Suchradius um die vorhergesagten Positionen (px)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="115" />
+            <location filename="../processing/algorithms/detecttargets.py" line="119" />
             <source>Minimum score (lower scores are flagged)</source>
             <translation>Mindestbewertung (niedrigere Bewertungen werden markiert)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="124" />
+            <location filename="../processing/algorithms/detecttargets.py" line="128" />
             <source>Refine by least-squares matching</source>
             <translation>Mit Kleinste-Quadrate-Zuordnung verfeinern</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="130" />
+            <location filename="../processing/algorithms/detecttargets.py" line="134" />
             <source>Target measurements (observation table)</source>
             <translation>Markenmessungen (Beobachtungstabelle)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="193" />
+            <location filename="../processing/algorithms/detecttargets.py" line="197" />
             <source>MARKER_IDS: give the mapping of marker IDs to GCP names, e.g. 0=GCP1,1=GCP2</source>
             <translation>MARKER_IDS: geben Sie die Zuordnung von Marker-IDs zu Passpunktnamen an, z. B. 0=GCP1,1=GCP2</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="208" />
+            <location filename="../processing/algorithms/detecttargets.py" line="212" />
             <source>{} measurements ({} flagged) in {} images</source>
             <translation>{} Messungen ({} markiert) in {} Bildern</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="76" />
+            <location filename="../processing/algorithms/detecttargets.py" line="80" />
             <source>ArUco markers</source>
             <translation>ArUco-Marker</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="76" />
+            <location filename="../processing/algorithms/detecttargets.py" line="80" />
             <source>Circular targets</source>
             <translation>Kreisförmige Marken</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="76" />
+            <location filename="../processing/algorithms/detecttargets.py" line="80" />
             <source>Checkerboard (X) targets</source>
             <translation>Schachbrettmarken (X)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="190" />
+            <location filename="../processing/algorithms/detecttargets.py" line="194" />
             <source>{} predicted positions</source>
             <translation>{} vorhergesagte Positionen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="145" />
+            <location filename="../processing/algorithms/detecttargets.py" line="149" />
             <source>MARKER_IDS: GCP name(s) {} are not in the GCP layer (it has {})</source>
             <translation>MARKER_IDS: Passpunktname(n) {} fehlen im Passpunktlayer (er enthält {})</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="178" />
+            <location filename="../processing/algorithms/detecttargets.py" line="182" />
             <source>{} targets are searched near their predicted positions: give ORIENTATION and GCPS</source>
             <translation>{}-Marken werden nahe ihren vorhergesagten Positionen gesucht: geben Sie ORIENTATION und GCPS an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="186" />
+            <location filename="../processing/algorithms/detecttargets.py" line="190" />
             <source>No GCP projects into an image of {} with this orientation (the same photos?)</source>
             <translation>Kein Passpunkt wird mit dieser Orientierung in ein Bild von {} projiziert (dieselben Fotos?)</translation>
         </message>
@@ -1937,11 +1942,6 @@
             <location filename="../processing/provider.py" line="62" />
             <source>TruOrtho {} — orientation, dense matching and true orthophotos</source>
             <translation>TruOrtho {} — Orientierung, dichte Bildzuordnung und True Orthophotos</translation>
-        </message>
-        <message>
-            <location filename="../processing/provider.py" line="78" />
-            <source>TruOrtho algorithms could not be loaded: {}</source>
-            <translation>TruOrtho-Algorithmen konnten nicht geladen werden: {}</translation>
         </message>
         <message>
             <location filename="../processing/provider.py" line="96" />

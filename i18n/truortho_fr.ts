@@ -24,37 +24,42 @@
             <translation>Outils</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="145" />
+            <location filename="../processing/algorithms/base.py" line="161" />
             <source>Run tiles on</source>
             <translation>Exécuter les tuiles sur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="158" />
+            <location filename="../processing/algorithms/base.py" line="174" />
             <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
             <translation>Adresse du planificateur Dask (tls://hôte:port ou fichier de planificateur ; vide = TRUORTHO_DASK_SCHEDULER)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="178" />
+            <location filename="../processing/algorithms/base.py" line="194" />
             <source>Ground control points</source>
             <translation>Points d'appui</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="184" />
+            <location filename="../processing/algorithms/base.py" line="200" />
             <source>GCP image measurements (table)</source>
             <translation>Mesures image des points d'appui (table)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="147" />
+            <location filename="../processing/algorithms/base.py" line="119" />
+            <source>TruOrtho algorithms could not be loaded: {}</source>
+            <translation>Les algorithmes TruOrtho n'ont pas pu être chargés : {}</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/base.py" line="163" />
             <source>inprocess: this process (all cores)</source>
             <translation>inprocess : ce processus (tous les cœurs)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="148" />
+            <location filename="../processing/algorithms/base.py" line="164" />
             <source>local: a Dask cluster of worker processes on this computer</source>
             <translation>local : une grappe Dask de processus de travail sur cet ordinateur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="149" />
+            <location filename="../processing/algorithms/base.py" line="165" />
             <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
             <translation>scheduler : un planificateur Dask (SCHEDULER_ADDRESS)</translation>
         </message>
@@ -64,92 +69,92 @@
             <translation>Détecter les cibles au sol</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="69" />
+            <location filename="../processing/algorithms/detecttargets.py" line="73" />
             <source>Image folder</source>
             <translation>Dossier des images</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="75" />
+            <location filename="../processing/algorithms/detecttargets.py" line="79" />
             <source>Target type</source>
             <translation>Type de cible</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="83" />
+            <location filename="../processing/algorithms/detecttargets.py" line="87" />
             <source>ArUco dictionary</source>
             <translation>Dictionnaire ArUco</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="90" />
+            <location filename="../processing/algorithms/detecttargets.py" line="94" />
             <source>Marker IDs -&gt; GCP names (e.g. 0=GCP1,1=GCP2)</source>
             <translation>ID des marqueurs -&gt; noms des points d'appui (p. ex. 0=GCP1,1=GCP2)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="95" />
+            <location filename="../processing/algorithms/detecttargets.py" line="99" />
             <source>Orientation (TruOrtho JSON)</source>
             <translation>Orientation (JSON TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="106" />
+            <location filename="../processing/algorithms/detecttargets.py" line="110" />
             <source>Search radius around predicted positions (px)</source>
             <translation>Rayon de recherche autour des positions prédites (px)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="115" />
+            <location filename="../processing/algorithms/detecttargets.py" line="119" />
             <source>Minimum score (lower scores are flagged)</source>
             <translation>Score minimal (les scores inférieurs sont signalés)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="124" />
+            <location filename="../processing/algorithms/detecttargets.py" line="128" />
             <source>Refine by least-squares matching</source>
             <translation>Affiner par corrélation par moindres carrés</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="130" />
+            <location filename="../processing/algorithms/detecttargets.py" line="134" />
             <source>Target measurements (observation table)</source>
             <translation>Mesures des cibles (table d'observations)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="193" />
+            <location filename="../processing/algorithms/detecttargets.py" line="197" />
             <source>MARKER_IDS: give the mapping of marker IDs to GCP names, e.g. 0=GCP1,1=GCP2</source>
             <translation>MARKER_IDS : indiquez la correspondance entre ID des marqueurs et noms des points d'appui, p. ex. 0=GCP1,1=GCP2</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="208" />
+            <location filename="../processing/algorithms/detecttargets.py" line="212" />
             <source>{} measurements ({} flagged) in {} images</source>
             <translation>{} mesures ({} signalées) dans {} images</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="76" />
+            <location filename="../processing/algorithms/detecttargets.py" line="80" />
             <source>ArUco markers</source>
             <translation>Marqueurs ArUco</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="76" />
+            <location filename="../processing/algorithms/detecttargets.py" line="80" />
             <source>Circular targets</source>
             <translation>Cibles circulaires</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="76" />
+            <location filename="../processing/algorithms/detecttargets.py" line="80" />
             <source>Checkerboard (X) targets</source>
             <translation>Cibles en damier (X)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="190" />
+            <location filename="../processing/algorithms/detecttargets.py" line="194" />
             <source>{} predicted positions</source>
             <translation>{} positions prédites</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="145" />
+            <location filename="../processing/algorithms/detecttargets.py" line="149" />
             <source>MARKER_IDS: GCP name(s) {} are not in the GCP layer (it has {})</source>
             <translation>MARKER_IDS : le(s) nom(s) de point d'appui {} ne figure(nt) pas dans la couche des points d'appui (elle contient {})</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="178" />
+            <location filename="../processing/algorithms/detecttargets.py" line="182" />
             <source>{} targets are searched near their predicted positions: give ORIENTATION and GCPS</source>
             <translation>Les cibles {} sont cherchées près de leurs positions prédites : indiquez ORIENTATION et GCPS</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/detecttargets.py" line="186" />
+            <location filename="../processing/algorithms/detecttargets.py" line="190" />
             <source>No GCP projects into an image of {} with this orientation (the same photos?)</source>
             <translation>Aucun point d'appui ne se projette dans une image de {} avec cette orientation (les mêmes photos ?)</translation>
         </message>
@@ -1937,11 +1942,6 @@
             <location filename="../processing/provider.py" line="62" />
             <source>TruOrtho {} — orientation, dense matching and true orthophotos</source>
             <translation>TruOrtho {} — orientation, appariement dense et orthophotos vraies</translation>
-        </message>
-        <message>
-            <location filename="../processing/provider.py" line="78" />
-            <source>TruOrtho algorithms could not be loaded: {}</source>
-            <translation>Les algorithmes TruOrtho n'ont pas pu être chargés : {}</translation>
         </message>
         <message>
             <location filename="../processing/provider.py" line="96" />
