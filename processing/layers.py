@@ -34,7 +34,7 @@ from qgis.core import (
 from qgis.PyQt.QtCore import QVariant
 
 from ..core.geometry.rotation import matrix_to_opk
-from ..core.orientation import GCP, Orientation
+from ..core.orientation import GCP, Orientation, isotropic_sigma
 from .i18n import tr
 
 GCP_REQUIRED_FIELDS = ("name",)
@@ -305,12 +305,9 @@ def _observation_sigma(feat, fields: list[str], layer_name: str) -> float | None
     if values.get("sigma") is not None:
         s = values["sigma"]
     else:
-        sx, sy = values.get("sigma_x"), values.get("sigma_y")
-        if sx is None and sy is None:
+        s = isotropic_sigma(values.get("sigma_x"), values.get("sigma_y"))
+        if s is None:
             return None
-        sx = sy if sx is None else sx
-        sy = sx if sy is None else sy
-        s = math.sqrt((sx * sx + sy * sy) / 2.0)  # type: ignore[operator]
     if not s > 0:  # type: ignore[operator]
         raise QgsProcessingException(
             tr("Observation table {!r}, feature {}: sigma must be positive, got {}").format(

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FormatError, InputError
-from ..orientation import GCP, Orientation, atomic_write_text
+from ..orientation import GCP, Orientation, atomic_write_text, isotropic_sigma
 
 #: Where a measurement came from.
 SOURCES = ("manual", "predicted", "detected", "refined")
@@ -531,10 +531,21 @@ class MeasurementSet:
     def to_gcp_records(self) -> list[GCP]:
         """The measured GCPs as :class:`~truortho.core.orientation.GCP` records (world frame)."""
         by: dict[str, list[tuple[str, float, float]]] = {}
+        sigmas: dict[str, dict[str, float]] = {}
         for m in self.measurements():
             by.setdefault(m.gcp, []).append((m.image, m.x, m.y))
+            s = isotropic_sigma(m.sigma_x, m.sigma_y)  # refined or detected: the bundle's weight
+            if s is not None:
+                sigmas.setdefault(m.gcp, {})[m.image] = s
         return [
-            GCP(g.name, np.asarray(g.xyz), "check" if g.check else "gcp", None, by[g.name])
+            GCP(
+                g.name,
+                np.asarray(g.xyz),
+                "check" if g.check else "gcp",
+                None,
+                by[g.name],
+                sigmas.get(g.name, {}),
+            )
             for g in self._gcps
             if g.name in by
         ]

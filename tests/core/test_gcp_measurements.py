@@ -71,6 +71,10 @@ def test_place_move_delete_undo_redo(mset):
     assert not mset.delete("g1", im1)  # nothing to delete: no command
     assert mset.undo()  # delete undone
     assert mset.get("g1", im1).sigma_x == 0.5
+    # the sigmas reach the bundle as the measurement's weight (one sigma: the RMS of x and y)
+    rec = {g.name: g for g in mset.to_gcp_records()}
+    assert rec["g1"].obs_sigma == {im1: pytest.approx(((0.5**2 + 0.7**2) / 2) ** 0.5)}
+    assert rec["g0"].obs_sigma == {}
     assert mset.undo()  # move undone
     assert (mset.get("g0", im0).x, mset.get("g0", im0).y) == (10.25, 20.5)
     assert mset.redo()  # move redone
