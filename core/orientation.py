@@ -90,11 +90,10 @@ class Image:
 def isotropic_sigma(sigma_x: float | None, sigma_y: float | None) -> float | None:
     """One measurement sigma for both image axes (the bundle weights x and y alike): the RMS of
     ``sigma_x`` and ``sigma_y``, the one given when the other is None, None when neither is."""
-    if sigma_x is None and sigma_y is None:
+    given = [float(s) for s in (sigma_x, sigma_y) if s is not None]
+    if not given:
         return None
-    sx = float(sigma_y if sigma_x is None else sigma_x)
-    sy = float(sigma_x if sigma_y is None else sigma_y)
-    return math.sqrt((sx * sx + sy * sy) / 2.0)
+    return math.sqrt(sum(s * s for s in given) / len(given))
 
 
 @dataclass
