@@ -167,3 +167,22 @@ def truortho_provider(truortho_plugin):
     provider = QgsApplication.processingRegistry().providerById("truortho")
     assert provider is not None, "TruOrtho provider is not registered"
     return provider
+
+
+@pytest.fixture(scope="session")
+def run_qgis_process():
+    """``run(*args, timeout=300)``: scripts/qgis_process (this environment, QGIS's own variables
+    dropped so the isolated profile applies) as a subprocess, captured, with no stdin."""
+    import subprocess
+
+    exe = REPO_ROOT / "scripts" / "qgis_process"
+    if not (REPO_ROOT / ".venv" / "qgis-config").is_dir():
+        pytest.fail("run scripts/setup.sh (make setup) first: no .venv/qgis-config")
+
+    def run(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
+        env = {k: v for k, v in os.environ.items() if not k.startswith("QGIS_")}
+        cmd = [str(exe), *args]
+        kw = {"capture_output": True, "text": True, "timeout": timeout, "env": env}
+        return subprocess.run(cmd, stdin=subprocess.DEVNULL, **kw)
+
+    return run

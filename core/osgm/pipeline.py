@@ -39,7 +39,7 @@ import numpy as np
 from ..errors import CancelledError, InputError
 from ..geometry.frame import parse_crs, require_metric
 from ..grid import RasterGrid
-from ..orientation import as_orientation
+from ..orientation import Orientation, as_orientation
 from ..parallel import (
     EXECUTORS,
     Digest,
@@ -673,7 +673,6 @@ def _run_systems(
     o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
     z_surface, progress, t0,
 ) -> OsgmResult:  # fmt: skip
-    off = o.offset
     if z_surface is not None:
         zsrc = "Z_SURFACE"
     chunks = plan_chunks(grid, cfg, plan_levels(zmin, zmax, dz, local, cfg.max_levels).levels[0])
@@ -694,32 +693,56 @@ def _run_systems(
     progress.update(0.85, "writing outputs")
     written = _write_outputs(o, grid, dsm, conf, surf.rgb, surf.clouds, surf.systems, outputs, res)
     ok = np.isfinite(dsm)
-    stats = {
-        "rows": grid.rows,
-        "cols": grid.cols,
-        "resolution": res,
-        "z_step": dz,
-        "z_min": zmin + off[2],
-        "z_max": zmax + off[2],
-        "z_source": zsrc,
-        "z_mid": zs_mid + off[2],
-        "levels": surf.levels,
-        "tiles": surf.tiles,
-        "chunks": 1,
-        "extent": list(grid.extent),
-        "completeness": float(ok.mean()),
-        "mean_confidence": float(np.nanmean(conf)) if ok.any() else 0.0,
-        "systems": sys_stats,
-        "images": len(o.images),
-        "image_reads": pyr.reads,
-        "executor": executor.describe() if hasattr(executor, "describe") else type(executor).__name__,
-        "cache_hits": cache.hits,
-        "cache_tiles_written": cache.written,
-        "task_volume_bytes": 4 * surf.max_volume,
-        "seconds": time.perf_counter() - t0,
-    }
+    run = _RunInfo(o, grid, res, dz, zmin, zmax, zsrc, zs_mid, pyr, executor, cache, t0)
+    stats = run.stats(surf.levels, surf.tiles, 1, float(ok.mean()),
+                      float(np.nanmean(conf)) if ok.any() else 0.0, sys_stats, surf.max_volume)  # fmt: skip
     progress.update(1.0, "OSGM done")
     return OsgmResult(grid, stats, written)
+
+
+@dataclass
+class _RunInfo:
+    """What the statistics of a run say besides its results (one run or chunks)."""
+
+    o: Orientation
+    grid: RasterGrid
+    res: float
+    dz: float
+    zmin: float
+    zmax: float
+    zsrc: str
+    zs_mid: float
+    pyr: ImagePyramid
+    executor: object
+    cache: TileCache
+    t0: float
+
+    def stats(self, levels, tiles, chunks, completeness, mean_confidence, systems, max_volume) -> dict:
+        off, g, ex = self.o.offset, self.grid, self.executor
+        return {
+            "rows": g.rows,
+            "cols": g.cols,
+            "resolution": self.res,
+            "z_step": self.dz,
+            "z_min": self.zmin + off[2],
+            "z_max": self.zmax + off[2],
+            "z_source": self.zsrc,
+            "z_mid": self.zs_mid + off[2],
+            "levels": levels,
+            "tiles": tiles,
+            "chunks": chunks,
+            "extent": list(g.extent),
+            "completeness": completeness,
+            "mean_confidence": mean_confidence,
+            "systems": systems,
+            "images": len(self.o.images),
+            "image_reads": self.pyr.reads,
+            "executor": ex.describe() if hasattr(ex, "describe") else type(ex).__name__,
+            "cache_hits": self.cache.hits,
+            "cache_tiles_written": self.cache.written,
+            "task_volume_bytes": 4 * max_volume,
+            "seconds": time.perf_counter() - self.t0,
+        }
 
 
 #: Bytes per finest-level cell that a chunk holds at once: the levels' heights and confidences
@@ -761,7 +784,6 @@ def _run_chunked(
     from ..rasterio_io import RasterWriter
     from ..surface.pointcloud import PointCloud, PointCloudFile, ReferenceSystem, merge_point_clouds
 
-    off = o.offset
     systems = reference_systems(o, cfg.oblique, cfg.oblique_group_angle)
     refs = [
         ReferenceSystem(s.id, s.name, (float(s.direction[0]), float(s.direction[1]), float(s.direction[2])))
@@ -846,30 +868,9 @@ def _run_chunked(
         if getattr(outputs, name) is not None:
             written[name] = str(getattr(outputs, name))
     cells = grid.rows * grid.cols
-    stats = {
-        "rows": grid.rows,
-        "cols": grid.cols,
-        "resolution": res,
-        "z_step": dz,
-        "z_min": zmin + off[2],
-        "z_max": zmax + off[2],
-        "z_source": zsrc,
-        "z_mid": zs_mid + off[2],
-        "levels": levels,
-        "tiles": tiles,
-        "chunks": len(chunks),
-        "extent": list(grid.extent),
-        "completeness": valid / max(cells, 1),
-        "mean_confidence": conf_sum / valid if valid else 0.0,
-        "systems": _system_stats(systems, points[0], points[1:], len(o.images)),
-        "images": len(o.images),
-        "image_reads": pyr.reads,
-        "executor": executor.describe() if hasattr(executor, "describe") else type(executor).__name__,
-        "cache_hits": cache.hits,
-        "cache_tiles_written": cache.written,
-        "task_volume_bytes": 4 * max_volume,
-        "seconds": time.perf_counter() - t0,
-    }
+    run = _RunInfo(o, grid, res, dz, zmin, zmax, zsrc, zs_mid, pyr, executor, cache, t0)
+    stats = run.stats(levels, tiles, len(chunks), valid / max(cells, 1), conf_sum / valid if valid else 0.0,
+                      _system_stats(systems, points[0], points[1:], len(o.images)), max_volume)  # fmt: skip
     progress.update(1.0, "OSGM done")
     return OsgmResult(grid, stats, written)
 

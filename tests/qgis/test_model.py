@@ -5,9 +5,7 @@ filter -> true orthophoto and mesh; every output written, in the block's CRS and
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +14,6 @@ import pytest
 pytestmark = pytest.mark.qgis
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
-QGIS_PROCESS = REPO_ROOT / "scripts" / "qgis_process"
 MODEL_ID = "truortho:truortho_chain"
 RES = 0.5
 
@@ -33,20 +30,10 @@ OUTPUTS = {
 }
 
 
-def _run_qgis_process(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    env = {k: v for k, v in os.environ.items() if not k.startswith("QGIS_")}
-    return subprocess.run(
-        [str(QGIS_PROCESS), *args],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        env=env,
-        stdin=subprocess.DEVNULL,
-    )
 
 
 @pytest.fixture(scope="module")
-def block(tmp_path_factory):
+def block(tmp_path_factory, run_qgis_process):
     """A 6-image nadir block: images alone in images/, the GCP layer and table from its gcp_list.txt."""
     if not (REPO_ROOT / ".venv" / "qgis-config").is_dir():
         pytest.fail("run scripts/setup.sh (make setup) first: no .venv/qgis-config")
@@ -72,7 +59,7 @@ def block(tmp_path_factory):
     for im in scene.orientation.images:
         shutil.copy(root / "scene" / im.name, images / im.name)
     checks = ",".join(g.name for g in scene.orientation.gcps if g.role == "check")
-    proc = _run_qgis_process(
+    proc = run_qgis_process(
         "run",
         "truortho:importgcps",
         "--",
@@ -85,15 +72,15 @@ def block(tmp_path_factory):
     return scene, root
 
 
-def test_model_listed():
-    proc = _run_qgis_process("help", MODEL_ID)
+def test_model_listed(run_qgis_process):
+    proc = run_qgis_process("help", MODEL_ID)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for name in ("IMAGES", "GCPS", "OBSERVATIONS", "CRS", "RESOLUTION", *OUTPUTS):
         assert f"{name}:" in proc.stdout, name
 
 
 @pytest.mark.slow
-def test_model_runs_whole_chain(block, tmp_path):
+def test_model_runs_whole_chain(block, tmp_path, run_qgis_process):
     import rasterio
     from osgeo import ogr
 
@@ -102,7 +89,7 @@ def test_model_runs_whole_chain(block, tmp_path):
     scene, root = block
     crs = scene.config.crs
     out = {name: tmp_path / fname for name, fname in OUTPUTS.items()}
-    proc = _run_qgis_process(
+    proc = run_qgis_process(
         "run",
         MODEL_ID,
         "--",
@@ -172,7 +159,7 @@ def test_model_runs_whole_chain(block, tmp_path):
     assert len(cloud.xyz) > 1000
     # the same inputs through truortho:pipeline give the same products
     pipe = tmp_path / "pipeline"
-    proc = _run_qgis_process(
+    proc = run_qgis_process(
         "run", "truortho:pipeline", "--", f"IMAGES={root / 'images'}", f"GCPS={root / 'gcps.gpkg'}",
         f"OBSERVATIONS={root / 'observations.gpkg'}", f"CRS={crs}", f"RESOLUTION={RES}",
         f"OUTPUT_FOLDER={pipe}",
@@ -197,10 +184,10 @@ def test_model_runs_whole_chain(block, tmp_path):
             assert np.allclose(da.filled(0), db.filled(0), atol=1e-4), name
 
 
-def test_model_bad_input(tmp_path):
+def test_model_bad_input(tmp_path, run_qgis_process):
     """A missing image folder stops the model at its first step with a message naming IMAGES."""
     out = {name: tmp_path / fname for name, fname in OUTPUTS.items()}
-    proc = _run_qgis_process(
+    proc = run_qgis_process(
         "run", MODEL_ID, "--", f"IMAGES={tmp_path / 'nowhere'}", "CRS=EPSG:32632",
         *(f"{name}={path}" for name, path in out.items()),
     )  # fmt: skip

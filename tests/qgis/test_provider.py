@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import os
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -12,7 +11,6 @@ import pytest
 pytestmark = pytest.mark.qgis
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
-QGIS_PROCESS = REPO_ROOT / "scripts" / "qgis_process"
 
 
 def test_provider_registered(truortho_provider):
@@ -28,7 +26,6 @@ def test_provider_registered(truortho_provider):
 
 
 def test_algorithms_list_matches_provider(truortho_provider):
-    import os
 
     from truortho.processing.algorithms import ALGORITHMS
     from truortho.processing.provider import MODELS_DIR
@@ -81,16 +78,6 @@ def test_environment_algorithm_rejects_foreign_gdal(truortho_provider, tmp_path,
         processing.run("truortho:environment", {"OUTPUT": str(tmp_path / "env.json")})
 
 
-def _run_qgis_process(*args: str) -> subprocess.CompletedProcess:
-    env = {k: v for k, v in os.environ.items() if not k.startswith("QGIS_")}
-    return subprocess.run(
-        [str(QGIS_PROCESS), *args],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        env=env,
-        stdin=subprocess.DEVNULL,
-    )
 
 
 @pytest.fixture(scope="module")
@@ -99,15 +86,15 @@ def set_up():
         pytest.fail("run scripts/setup.sh (make setup) first: no .venv/qgis-config")
 
 
-def test_qgis_process_lists_algorithm(set_up):
-    proc = _run_qgis_process("list")
+def test_qgis_process_lists_algorithm(set_up, run_qgis_process):
+    proc = run_qgis_process("list")
     assert proc.returncode == 0, proc.stderr
     assert "truortho:environment" in proc.stdout, proc.stdout + proc.stderr
 
 
-def test_qgis_process_runs_environment(set_up, tmp_path):
+def test_qgis_process_runs_environment(set_up, tmp_path, run_qgis_process):
     out = tmp_path / "env.json"
-    proc = _run_qgis_process("run", "truortho:environment", "--", f"OUTPUT={out}")
+    proc = run_qgis_process("run", "truortho:environment", "--", f"OUTPUT={out}")
     assert proc.returncode == 0, proc.stdout + proc.stderr
     versions = json.loads(out.read_text())
     assert versions["rasterio_gdal"] == versions["qgis_gdal"]

@@ -10,9 +10,7 @@
 from __future__ import annotations
 
 import json
-import os
 import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -21,19 +19,8 @@ import pytest
 pytestmark = pytest.mark.qgis
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
-QGIS_PROCESS = REPO_ROOT / "scripts" / "qgis_process"
 
 
-def _qgis_process(*args: str, timeout: float = 300) -> subprocess.CompletedProcess:
-    env = {k: v for k, v in os.environ.items() if not k.startswith("QGIS_")}
-    return subprocess.run(
-        [str(QGIS_PROCESS), *args],
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-        env=env,
-        stdin=subprocess.DEVNULL,
-    )
 
 
 def _run(alg, params):
@@ -68,14 +55,14 @@ def test_help_is_plain_text(truortho_provider):
                 assert f"\n{p.name()}: " in text, f"{alg.id()}: {p.name()} missing from the help"
 
 
-def test_qgis_process_help_and_single_error(tmp_path):
-    out = _qgis_process("help", "truortho:orientimages")
+def test_qgis_process_help_and_single_error(tmp_path, run_qgis_process):
+    out = run_qgis_process("help", "truortho:orientimages")
     assert out.returncode == 0, out.stderr
     assert "&#" not in out.stdout and "<p>" not in out.stdout and "<dt>" not in out.stdout
     assert "\nIMAGES: Folder of the images" in out.stdout
 
     missing = tmp_path / "no_such_folder"
-    res = _qgis_process(
+    res = run_qgis_process(
         "run", "truortho:orientimages", "--", f"IMAGES={missing}", f"ORIENTATION={tmp_path / 'o.json'}"
     )
     assert res.returncode != 0
@@ -85,9 +72,9 @@ def test_qgis_process_help_and_single_error(tmp_path):
     assert "mandatory parameters" not in res.stderr  # CAMERAS and REPORT are optional
 
 
-def test_importorientation_without_cameras_through_qgis_process(tmp_path):
+def test_importorientation_without_cameras_through_qgis_process(tmp_path, run_qgis_process):
     src = _small_orientation(tmp_path)
-    res = _qgis_process(
+    res = run_qgis_process(
         "run", "truortho:importorientation", "--", f"INPUT={src}", f"OUTPUT={tmp_path / 'o.json'}"
     )
     assert res.returncode == 0, res.stderr
