@@ -503,6 +503,81 @@ def georeference_block(
     return OrientGeoref(block, track_ids, gcfg, offset, gps_local, geo, bundle, crs_out)
 
 
+def report_block(
+    inputs: OrientInputs,
+    m: OrientMatches,
+    r: OrientReconstruction,
+    g: OrientGeoref,
+    orientation: Orientation,
+    tie: dict,
+    bundle,
+    geo,
+    times: dict,
+    warnings: list[str],
+    tie_refinement: dict | None,
+) -> tuple[Report, list[dict]]:
+    """The last stage: the run's statistics and report, and the GCP / check-point residual rows.
+
+    ``bundle`` and ``geo`` are the final adjustment and datum (``g``'s, or those after the
+    tie-point refinement).
+
+    Returns
+    -------
+    (Report, list of dict)
+        The orientation report (tables, figures, warnings, data) and one row per control or check
+        point with its residuals and ``role``.
+    """
+    names = inputs.names
+    sel, fstats, mstats = m.selection, m.feature_stats, m.match_stats
+    rec, tracks, n_verified = r.rec, r.tracks, r.n_verified
+    block = g.block
+    stats = {
+        "summary": {
+            "pairs tried": f"{sel.n_pairs} of {sel.n_exhaustive} ({sel.strategy})",
+            "verified pairs": n_verified,
+            "tie points before decimation": tracks.stats.get("decimation", {}).get(
+                "tracks_before", tracks.n_tracks
+            ),
+            "wall time [s]": round(times["total"], 1),
+        },
+        "timings": times,
+        "features": {k: v for k, v in fstats.items() if k != "seconds_per_image"},
+        "pairs": {
+            "strategy": sel.strategy,
+            "tried": sel.n_pairs,
+            "exhaustive": sel.n_exhaustive,
+            "verified": n_verified,
+        },
+        "matching": mstats,
+        "tracks": tracks.stats,
+        "reconstruction": rec.stats,
+        "cameras": inputs.cam_info,
+        "warnings": warnings,
+    }
+    if tie_refinement is not None:
+        stats["tie_refinement"] = tie_refinement
+    reg_idx = np.flatnonzero(rec.registered)
+    rep = orientation_report(
+        "TruOrtho orientation report",
+        names,
+        rec.registered,
+        orientation.frame.to_world(np.array([im.C for im in orientation.images])),
+        tie["xyz"],
+        tie["multiplicity"],
+        bundle,
+        block.obs_image,
+        block.obs_xy,
+        geo if geo.method != "none" else GeorefResult("none", warnings=geo.warnings),
+        stats,
+        block.cameras,
+    )
+    rep.data["registered_images"] = [names[i] for i in reg_idx]
+    residuals = [{**row, "role": "gcp"} for row in geo.gcp_table] + [
+        {**row, "role": "check"} for row in geo.check_table
+    ]
+    return rep, residuals
+
+
 def orient_images(
     paths,
     camera_file=None,
@@ -540,11 +615,10 @@ def orient_images(
     t = time.perf_counter()
     inputs = read_inputs(paths, camera_file, gcps, crs, warnings, steps[0], prog)
     times["inventory"] = time.perf_counter() - t
-    paths, names, cam_info = inputs.paths, inputs.names, inputs.cam_info
+    paths = inputs.paths
     m = match_images(inputs, cfg, work_dir, (steps[1], steps[2]), times)
-    features, fstats, sel, mstats = m.features, m.feature_stats, m.selection, m.match_stats
     r = reconstruct_block(inputs, m, cfg, camera_file, warnings, (steps[3], steps[4]), prog, times)
-    rec, tracks, n_verified = r.rec, r.tracks, r.n_verified
+    rec, tracks = r.rec, r.tracks
     n_reg = int(rec.registered.sum())
 
     t = time.perf_counter()
@@ -561,54 +635,13 @@ def orient_images(
         times["tie refinement"] = time.perf_counter() - t
 
     orientation, tie = _build_orientation(
-        block, track_ids, tracks, features, bundle, paths, rec, crs_out, offset, gcps
+        block, track_ids, tracks, m.features, bundle, paths, rec, crs_out, offset, gcps
     )
     steps[6].update(1.0, "report")
     times["total"] = time.perf_counter() - t_start
-    stats = {
-        "summary": {
-            "pairs tried": f"{sel.n_pairs} of {sel.n_exhaustive} ({sel.strategy})",
-            "verified pairs": n_verified,
-            "tie points before decimation": tracks.stats.get("decimation", {}).get(
-                "tracks_before", tracks.n_tracks
-            ),
-            "wall time [s]": round(times["total"], 1),
-        },
-        "timings": times,
-        "features": {k: v for k, v in fstats.items() if k != "seconds_per_image"},
-        "pairs": {
-            "strategy": sel.strategy,
-            "tried": sel.n_pairs,
-            "exhaustive": sel.n_exhaustive,
-            "verified": n_verified,
-        },
-        "matching": mstats,
-        "tracks": tracks.stats,
-        "reconstruction": rec.stats,
-        "cameras": cam_info,
-        "warnings": warnings,
-    }
-    if tie_refinement is not None:
-        stats["tie_refinement"] = tie_refinement
-    reg_idx = np.flatnonzero(rec.registered)
-    rep = orientation_report(
-        "TruOrtho orientation report",
-        names,
-        rec.registered,
-        orientation.frame.to_world(np.array([im.C for im in orientation.images])),
-        tie["xyz"],
-        tie["multiplicity"],
-        bundle,
-        block.obs_image,
-        block.obs_xy,
-        geo if geo.method != "none" else GeorefResult("none", warnings=geo.warnings),
-        stats,
-        block.cameras,
+    rep, residuals = report_block(
+        inputs, m, r, g, orientation, tie, bundle, geo, times, warnings, tie_refinement
     )
-    rep.data["registered_images"] = [names[i] for i in reg_idx]
-    residuals = [{**r, "role": "gcp"} for r in geo.gcp_table] + [
-        {**r, "role": "check"} for r in geo.check_table
-    ]
     prog.update(1.0, f"oriented {n_reg} of {len(paths)} images")
     return OrientationRun(
         orientation, rep, tie["xyz"], tie["multiplicity"], tie["error"], tie["rgb"], residuals
