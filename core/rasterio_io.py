@@ -498,12 +498,10 @@ def valid_share(path, band: int = 1, block: int = 1024) -> float:
     grid = raster_grid(path, require_crs=False)
     valid = 0
     for t in grid.tiles(block):
-        data, _, _ = read_raster(path, band, t.core)
+        data, _, nod = read_raster(path, band, t.core)  # float nodata arrives as NaN
         if data.dtype.kind == "f":
             valid += int(np.isfinite(data).sum())
         else:
-            with _open(path) as ds:
-                nod = ds.nodata
             valid += int(data.size if nod is None else (data != nod).sum())
     return valid / max(grid.rows * grid.cols, 1)
 

@@ -266,8 +266,12 @@ def photo_counts(orientation, dsm, grid) -> np.ndarray:
     """How many photos see each cell of ``dsm`` (on ``grid``, world heights; NaN cells at the median
     height): the cell's surface point in front of the camera and inside the frame. Occlusion is not
     tested (this is the coverage of the flight, not of the true orthophoto)."""
+    from .errors import InputError
     from .geometry import project_points
 
+    dsm = np.asarray(dsm)
+    if dsm.shape != grid.shape:
+        raise InputError(f"photo_counts: heights of shape {dsm.shape} for a grid of {grid.shape}")
     X, Y = grid.centres()
     z = np.where(np.isfinite(dsm), dsm, np.nanmedian(dsm) if np.isfinite(dsm).any() else 0.0)
     off = np.asarray(orientation.offset, np.float64)

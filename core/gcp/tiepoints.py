@@ -22,7 +22,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import CancelledError, InputError
-from ..geometry.camera import Camera
 from ..progress import Progress, as_progress
 from .lsm import LsmConfig, MgcmView, extract_template, lsm_match, plane_shape
 
@@ -78,24 +77,6 @@ class TieRefinement:
     stats: dict = field(default_factory=dict)
 
 
-def _scaled_camera(cam: Camera, sx: float, sy: float) -> Camera:
-    """The camera of an image resampled by (sx, sy): ``x' = (x + 0.5) sx - 0.5``."""
-    return Camera(
-        max(1, int(round(cam.width * sx))),
-        max(1, int(round(cam.height * sy))),
-        cam.fx * sx,
-        cam.fy * sy,
-        (cam.cx + 0.5) * sx - 0.5,
-        (cam.cy + 0.5) * sy - 0.5,
-        cam.k1,
-        cam.k2,
-        cam.k3,
-        cam.p1,
-        cam.p2,
-        id=cam.id,
-    )
-
-
 def refine_tie_points(
     block,
     images,
@@ -140,7 +121,7 @@ def refine_tie_points(
                 images[i],
                 block.rotations[i],
                 block.centers[i],
-                _scaled_camera(cam, sc[i, 0], sc[i, 1]),
+                cam.scaled(float(sc[i, 0]), float(sc[i, 1])),
                 str(i),
             )
         )

@@ -115,22 +115,24 @@ class Camera:
         """Undistorted normalised coordinates of pixels, (N, 2) -> (N, 2)."""
         return undistort_points(uv, self, iterations)
 
-    def scaled(self, factor: float) -> Camera:
-        """The camera of the same images resampled by ``factor`` (e.g. 0.5 = half size).
+    def scaled(self, factor: float, factor_y: float | None = None) -> Camera:
+        """The camera of the same images resampled by ``factor`` (e.g. 0.5 = half size), or by
+        ``factor`` in x and ``factor_y`` in y.
 
         Pixel centres map as ``x' = (x + 0.5) * factor - 0.5``.
         """
-        if not factor > 0:
-            raise InputError(f"scale factor must be positive, got {factor}")
+        fy = factor if factor_y is None else factor_y
+        if not (factor > 0 and fy > 0):
+            raise InputError(f"scale factor must be positive, got {factor}, {fy}")
         w = max(1, int(round(self.width * factor)))
-        h = max(1, int(round(self.height * factor)))
+        h = max(1, int(round(self.height * fy)))
         return Camera(
             w,
             h,
             self.fx * factor,
-            self.fy * factor,
+            self.fy * fy,
             (self.cx + 0.5) * factor - 0.5,
-            (self.cy + 0.5) * factor - 0.5,
+            (self.cy + 0.5) * fy - 0.5,
             self.k1,
             self.k2,
             self.k3,

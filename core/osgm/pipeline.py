@@ -773,6 +773,39 @@ def plan_chunks(grid: RasterGrid, cfg: OsgmConfig, top_level: int):
     return grid.tiles(side, margin)
 
 
+def _references(systems) -> list:
+    """The point cloud's reference-system table (id, name, viewing direction) of ``systems``."""
+    from ..surface.pointcloud import ReferenceSystem
+
+    return [
+        ReferenceSystem(s.id, s.name, (float(s.direction[0]), float(s.direction[1]), float(s.direction[2])))
+        for s in systems
+    ]
+
+
+def _cloud_parts(grid: RasterGrid, dsm, rgb, conf, clouds, refs, crs, core=None) -> tuple[list, list[int]]:
+    """The point clouds of the nadir DSM's valid cells (``grid``) and of the oblique systems, and the
+    points per system. ``core``: ``(x0, y0, x1, y1)`` keeps only the oblique points whose plan
+    position lies in it (a chunk's core: every point in exactly one chunk)."""
+    from ..surface.pointcloud import PointCloud
+
+    ok = np.isfinite(dsm)
+    X, Y = grid.centres()
+    nadir = np.column_stack([X[ok], Y[ok], dsm[ok].astype(np.float64)])
+    parts = [PointCloud(nadir, rgb[ok], conf[ok], np.zeros(len(nadir), np.uint16), crs, [refs[0]])]
+    counts = [len(nadir)]
+    for (xyz, prgb, pconf), ref in zip(clouds, refs[1:], strict=True):
+        if core is not None:
+            x0, y0, x1, y1 = core
+            keep = (xyz[:, 0] >= x0) & (xyz[:, 0] < x1) & (xyz[:, 1] > y0) & (xyz[:, 1] <= y1)
+            xyz, pconf = xyz[keep], pconf[keep]
+            prgb = prgb[keep] if prgb is not None else None
+        counts.append(len(xyz))
+        if len(xyz):
+            parts.append(PointCloud(xyz, prgb, pconf, np.full(len(xyz), ref.id, np.uint16), crs, [ref]))
+    return parts, counts
+
+
 def _run_chunked(
     o, cfg, outputs, grid, local, pyr, executor, cache, cache_base, zmin, zmax, zsrc, zs_mid, dz, res,
     z_surface, progress, t0, chunks,
@@ -782,13 +815,10 @@ def _run_chunked(
 
     from ..progress import SubProgress
     from ..rasterio_io import RasterWriter
-    from ..surface.pointcloud import PointCloud, PointCloudFile, ReferenceSystem, merge_point_clouds
+    from ..surface.pointcloud import PointCloudFile, merge_point_clouds
 
     systems = reference_systems(o, cfg.oblique, cfg.oblique_group_angle)
-    refs = [
-        ReferenceSystem(s.id, s.name, (float(s.direction[0]), float(s.direction[1]), float(s.direction[2])))
-        for s in systems
-    ]
+    refs = _references(systems)
     valid = tiles = levels = max_volume = 0
     conf_sum = 0.0
     points = [0] * len(systems)
@@ -828,36 +858,9 @@ def _run_chunked(
                 w_conf.write(np.where(ok, conf, -1.0).astype(np.float32), ch.core)
             if w_rgb is not None:
                 w_rgb.write(np.moveaxis(rgb, -1, 0), ch.core)
-            # the oblique points whose plan position lies in this chunk's core (each point once)
-            cx0, cy0, cx1, cy1 = ch.core_grid(grid).extent
-            parts = []
             core = ch.core_grid(grid)
-            X, Y = core.centres()
-            parts.append(
-                PointCloud(
-                    np.column_stack([X[ok], Y[ok], dsm[ok].astype(np.float64)]),
-                    rgb[ok],
-                    conf[ok],
-                    np.zeros(int(ok.sum()), np.uint16),
-                    o.crs,
-                    [refs[0]],
-                )  # fmt: skip
-            )
-            points[0] += int(ok.sum())
-            for j, (xyz, prgb, pconf) in enumerate(surf.clouds, start=1):
-                inside = (xyz[:, 0] >= cx0) & (xyz[:, 0] < cx1) & (xyz[:, 1] > cy0) & (xyz[:, 1] <= cy1)
-                points[j] += int(inside.sum())
-                if inside.any():
-                    parts.append(
-                        PointCloud(
-                            xyz[inside],
-                            prgb[inside] if prgb is not None else None,
-                            pconf[inside],
-                            np.full(int(inside.sum()), refs[j].id, np.uint16),
-                            o.crs,
-                            [refs[j]],
-                        )  # fmt: skip
-                    )
+            parts, counts = _cloud_parts(core, dsm, rgb, conf, surf.clouds, refs, o.crs, core.extent)
+            points = [a + c for a, c in zip(points, counts, strict=True)]
             if cloud_file is not None:
                 merged = merge_point_clouds(parts, voxel=None) if len(parts) > 1 else parts[0]
                 cloud_file.add(merged)
@@ -934,34 +937,10 @@ def _write_outputs(o, grid, dsm, conf, rgb, clouds, systems, outputs: OsgmOutput
         write_raster(outputs.orthoimage, np.moveaxis(rgb, -1, 0), grid, nodata=0, overviews=True)
         written["orthoimage"] = str(outputs.orthoimage)
     if outputs.point_cloud is not None:
-        from ..surface.pointcloud import (
-            PointCloud,
-            ReferenceSystem,
-            merge_point_clouds,
-            write_point_cloud_file,
-        )
+        from ..surface.pointcloud import merge_point_clouds, write_point_cloud_file
 
-        ok = np.isfinite(dsm)
-        X, Y = grid.centres()
-        refs = [
-            ReferenceSystem(
-                s.id, s.name, (float(s.direction[0]), float(s.direction[1]), float(s.direction[2]))
-            )
-            for s in systems
-        ]
-        parts = [
-            PointCloud(
-                np.column_stack([X[ok], Y[ok], dsm[ok].astype(np.float64)]),
-                rgb[ok],
-                conf[ok],
-                np.zeros(int(ok.sum()), np.uint16),
-                o.crs,
-                [refs[0]],
-            )
-        ]
-        for (xyz, prgb, pconf), ref in zip(clouds, refs[1:], strict=True):
-            if len(xyz):
-                parts.append(PointCloud(xyz, prgb, pconf, np.full(len(xyz), ref.id, np.uint16), o.crs, [ref]))
+        refs = _references(systems)
+        parts, _ = _cloud_parts(grid, dsm, rgb, conf, clouds, refs, o.crs)
         cloud = merge_point_clouds(parts, voxel=None) if len(parts) > 1 else parts[0]
         cloud.systems = refs
         write_point_cloud_file(outputs.point_cloud, cloud)
