@@ -38,7 +38,7 @@ import cv2
 import numpy as np
 
 from ..errors import InputError
-from ..geometry.camera import Camera, _distort_one, project_points, undistort_points
+from ..geometry.camera import Camera, _distort_one, _undistort_one, project_points, undistort_points
 from ..jit import njit
 
 #: Order of the 10 unknowns in the kernels' normal equations.
@@ -162,23 +162,6 @@ class MgcmResult:
 
 
 @njit
-def _bilinear(img, x, y):
-    """Bilinear value at (x, y); NaN outside the pixel centres' hull."""
-    h, w = img.shape
-    if not (x >= 0.0 and y >= 0.0 and x <= w - 1 and y <= h - 1):
-        return np.nan
-    x0 = min(int(x), w - 2) if w > 1 else 0
-    y0 = min(int(y), h - 2) if h > 1 else 0
-    fx = x - x0
-    fy = y - y0
-    x1 = min(x0 + 1, w - 1)
-    y1 = min(y0 + 1, h - 1)
-    top = img[y0, x0] * (1.0 - fx) + img[y0, x1] * fx
-    bot = img[y1, x0] * (1.0 - fx) + img[y1, x1] * fx
-    return top * (1.0 - fy) + bot * fy
-
-
-@njit
 def _normals(template, img, gx, gy, p, r0, r1, N, b, resampled):
     """Normal equations of one image at parameters ``p`` (10, kernel order).
 
@@ -186,6 +169,7 @@ def _normals(template, img, gx, gy, p, r0, r1, N, b, resampled):
     returns ``(sum of squared residuals, number of samples, number outside the image)``.
     """
     th, tw = template.shape
+    hi, wi = img.shape
     hv = th // 2
     hu = tw // 2
     for i in range(10):
@@ -207,14 +191,26 @@ def _normals(template, img, gx, gy, p, r0, r1, N, b, resampled):
                 continue
             x = (p[8] + p[0] * u + p[1] * v) / w
             y = (p[9] + p[2] * u + p[3] * v) / w
-            g = _bilinear(img, x, y)
-            if np.isnan(g):
+            if not (x >= 0.0 and y >= 0.0 and x <= wi - 1 and y <= hi - 1):
                 outside += 1
                 resampled[iv, iu] = np.nan
                 continue
+            # bilinear, NaN outside the pixel centres' hull; the weights once for the image and
+            # its gradients
+            x0 = min(int(x), wi - 2) if wi > 1 else 0
+            y0 = min(int(y), hi - 2) if hi > 1 else 0
+            fx = x - x0
+            fy = y - y0
+            ax = 1.0 - fx
+            ay = 1.0 - fy
+            x1 = min(x0 + 1, wi - 1)
+            y1 = min(y0 + 1, hi - 1)
+            g = (img[y0, x0] * ax + img[y0, x1] * fx) * ay + (img[y1, x0] * ax + img[y1, x1] * fx) * fy
             resampled[iv, iu] = g
-            dgx = _bilinear(gx, x, y) * r1 / w
-            dgy = _bilinear(gy, x, y) * r1 / w
+            dgx = (gx[y0, x0] * ax + gx[y0, x1] * fx) * ay + (gx[y1, x0] * ax + gx[y1, x1] * fx) * fy
+            dgy = (gy[y0, x0] * ax + gy[y0, x1] * fx) * ay + (gy[y1, x0] * ax + gy[y1, x1] * fx) * fy
+            dgx = dgx * r1 / w
+            dgy = dgy * r1 / w
             row[0] = dgx * u
             row[1] = dgx * v
             row[2] = dgy * u
@@ -366,55 +362,134 @@ def _solve(N: np.ndarray, b: np.ndarray):
     return inv @ b, inv
 
 
-# ---------------------------------------------------------------- LSM
+# ---------------------------------------------------------------- LSM kernels
+
+#: Status codes of :func:`_lm_stage` and :func:`_match_many`, index into :data:`_REASONS`.
+_REASONS = (
+    "",
+    "singular (no texture)",
+    "left the image",
+    "moved farther than max_shift",
+    "degenerate shape",
+    "no convergence",
+    "start outside the image",
+    "image: NaN or infinite values near the start",
+)
 
 
-def _lsm_stage(t, window, ox, oy, p, r, cfg, start, it0):
-    """Levenberg-Marquardt iterations on one (possibly blurred) stage.
+@njit
+def _solve_small(N, b, sol, inv):
+    """:func:`_solve` in a kernel: fills ``sol`` and ``inv``; False when (nearly) singular."""
+    m = N.shape[0]
+    scale = np.empty(m)
+    for i in range(m):
+        scale[i] = math.sqrt(max(N[i, i], 1e-300))
+    Ns = np.empty((m, m))
+    for i in range(m):
+        for j in range(m):
+            Ns[i, j] = N[i, j] / (scale[i] * scale[j])
+    if not np.all(np.isfinite(Ns)):
+        return False
+    # Ns is symmetric: its singular values are the moduli of its eigenvalues (np.linalg.cond)
+    ev = np.abs(np.linalg.eigvalsh(Ns))
+    if not ev.min() > 0.0 or ev.max() / ev.min() > 1e12:
+        return False
+    Ni = np.linalg.inv(Ns)
+    for i in range(m):
+        for j in range(m):
+            inv[i, j] = Ni[i, j] / (scale[i] * scale[j])
+    for i in range(m):
+        acc = 0.0
+        for j in range(m):
+            acc += inv[i, j] * b[j]
+        sol[i] = acc
+    return True
 
-    Returns ``(p, r, it, reason, extras)``; a step that does not lower the residuals is retried
+
+@njit
+def _gradients_k(a, gx, gy):
+    """``np.gradient`` of a 2-D array (central inside, one-sided at the borders)."""
+    h, w = a.shape
+    for i in range(h):
+        for j in range(w):
+            if j == 0:
+                gx[i, j] = a[i, 1] - a[i, 0]
+            elif j == w - 1:
+                gx[i, j] = a[i, w - 1] - a[i, w - 2]
+            else:
+                gx[i, j] = (a[i, j + 1] - a[i, j - 1]) / 2.0
+            if i == 0:
+                gy[i, j] = a[1, j] - a[0, j]
+            elif i == h - 1:
+                gy[i, j] = a[h - 1, j] - a[h - 2, j]
+            else:
+                gy[i, j] = (a[i + 1, j] - a[i - 1, j]) / 2.0
+
+
+@njit
+def _lm_stage(t, window, gx, gy, pc, r, idx, n_shape, max_iter, tol, max_shift, ox, oy, sx, sy, inv, res):
+    """Levenberg-Marquardt iterations of one LSM stage (window pixels).
+
+    ``pc`` (10,) and ``r`` (r0, r1) are updated in place; ``idx``: the unknowns estimated (kernel
+    order), the first ``n_shape`` of them the damped shaping; ``(ox, oy)``: the window's offset in
+    the image and ``(sx, sy)`` the start in image pixels. On success ``inv`` (len(idx), len(idx))
+    holds the inverse normal matrix and ``res`` the image resampled under the template.
+    Returns ``(status, iterations, ssr, n)``; a step that does not lower the residuals is retried
     with more damping (symmetric targets otherwise make the shaping oscillate).
     """
-    gx, gy = _gradients(window)
-    local = _PROJECTIVE_LOCAL if cfg.projective else _AFFINE_LOCAL
-    idx = np.concatenate([local, _SHIFT])
-    shape_idx = np.arange(len(local) - 2)
+    m = idx.shape[0]
     N = np.zeros((10, 10))
     b = np.zeros(10)
     Nt = np.zeros((10, 10))
     bt = np.zeros(10)
-    res = np.zeros(t.shape)
-    pc = p.copy()
-    pc[8] -= ox
-    pc[9] -= oy
-    it = it0
+    Ns = np.empty((m, m))
+    Nd = np.empty((m, m))
+    bs = np.empty(m)
+    sol = np.empty(m)
+    full = np.zeros(10)
+    trial = np.empty(10)
     lam = 1e-3
     done = False
+    it = 0
     ssr, n, outside = _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
     if outside:
-        return pc, r, it, "left the image", None
-    for _ in range(cfg.max_iterations):
+        return 2, it, ssr, n
+    for _ in range(max_iter):
         it += 1
-        Ns = _damped(N[np.ix_(idx, idx)], shape_idx)
+        for i in range(m):
+            bs[i] = b[idx[i]]
+            for j in range(m):
+                Ns[i, j] = N[idx[i], idx[j]]
+        for i in range(n_shape):
+            Ns[i, i] *= 1.0 + _SHAPE_DAMPING
         accepted = False
         step = np.inf
         for _attempt in range(10):
-            Nd = Ns.copy()
-            Nd[np.diag_indices_from(Nd)] *= 1.0 + lam
-            sol = _solve(Nd, b[idx])
-            if sol is None:
-                return pc, r, it, "singular (no texture)", None
-            full = np.zeros(10)
-            full[idx] = sol[0]
-            trial = pc.copy()
-            trial[:6] += full[:6]
-            trial[8:] += full[8:]
-            rt = (r[0] + full[6], r[1] + full[7])
-            if np.all(np.isfinite(trial)) and rt[1] > 0:
-                ssr_t, n_t, out_t = _normals(t, window, gx, gy, trial, rt[0], rt[1], Nt, bt, res)
+            Nd[:, :] = Ns
+            for i in range(m):
+                Nd[i, i] *= 1.0 + lam
+            if not _solve_small(Nd, bs, sol, inv):
+                return 1, it, ssr, n
+            full[:] = 0.0
+            for i in range(m):
+                full[idx[i]] = sol[i]
+            trial[:] = pc
+            for i in range(6):
+                trial[i] += full[i]
+            trial[8] += full[8]
+            trial[9] += full[9]
+            r0t = r[0] + full[6]
+            r1t = r[1] + full[7]
+            if np.all(np.isfinite(trial)) and r1t > 0:
+                ssr_t, n_t, out_t = _normals(t, window, gx, gy, trial, r0t, r1t, Nt, bt, res)
                 if not out_t and ssr_t <= ssr:
-                    pc, r, ssr, n = trial, rt, ssr_t, n_t
-                    N[:], b[:] = Nt, bt
+                    pc[:] = trial
+                    r[0] = r0t
+                    r[1] = r1t
+                    ssr = ssr_t
+                    n = n_t
+                    N[:, :] = Nt
+                    b[:] = bt
                     lam = max(lam * 0.3, 1e-7)
                     accepted = True
                     step = math.hypot(full[8], full[9])
@@ -422,22 +497,286 @@ def _lsm_stage(t, window, ox, oy, p, r, cfg, start, it0):
             lam *= 10.0
         if not accepted:
             done = True  # no step lowers the residuals: at the minimum
-        if math.hypot(pc[8] + ox - start[0], pc[9] + oy - start[1]) > cfg.max_shift:
-            return pc, r, it, "moved farther than max_shift", None
+        if math.hypot(pc[8] + ox - sx, pc[9] + oy - sy) > max_shift:
+            return 3, it, ssr, n
         det = pc[0] * pc[3] - pc[1] * pc[2]
         if not 0.1 < abs(det) < 10.0:
-            return pc, r, it, "degenerate shape", None
-        if done or step < cfg.tolerance:
+            return 4, it, ssr, n
+        if done or step < tol:
             _normals(t, window, gx, gy, pc, r[0], r[1], N, b, res)
-            sol = _solve(N[np.ix_(idx, idx)], b[idx]) or _solve(
-                _damped(N[np.ix_(idx, idx)], shape_idx), b[idx]
-            )
-            if sol is None:
-                return pc, r, it, "singular (no texture)", None
-            pc[8] += ox
-            pc[9] += oy
-            return pc, r, it, "", (ssr, n, len(idx), sol[1], res.copy())
-    return pc, r, it, "no convergence", None
+            for i in range(m):
+                bs[i] = b[idx[i]]
+                for j in range(m):
+                    Ns[i, j] = N[idx[i], idx[j]]
+            if not _solve_small(Ns, bs, sol, inv):
+                for i in range(n_shape):
+                    Ns[i, i] *= 1.0 + _SHAPE_DAMPING
+                if not _solve_small(Ns, bs, sol, inv):
+                    return 1, it, ssr, n
+            return 0, it, ssr, n
+    return 5, it, ssr, n
+
+
+@njit
+def _ncc_k(a, b):
+    """:func:`_ncc` in a kernel: normalised cross-correlation over the finite values of ``b``."""
+    cnt = 0
+    sa = 0.0
+    sb = 0.0
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            if np.isfinite(b[i, j]):
+                cnt += 1
+                sa += a[i, j]
+                sb += b[i, j]
+    if cnt < 3:
+        return np.nan
+    ma = sa / cnt
+    mb = sb / cnt
+    sxx = 0.0
+    syy = 0.0
+    sxy = 0.0
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            if np.isfinite(b[i, j]):
+                x = a[i, j] - ma
+                y = b[i, j] - mb
+                sxx += x * x
+                syy += y * y
+                sxy += x * y
+    d = math.sqrt(sxx * syy)
+    return sxy / d if d > 0 else 0.0
+
+
+@njit
+def _radiometric_start(t, probe, r):
+    """Gain and offset matching the means and spreads of ``t`` and the finite ``probe`` values."""
+    cnt = 0
+    st = 0.0
+    sp = 0.0
+    for i in range(t.shape[0]):
+        for j in range(t.shape[1]):
+            if np.isfinite(probe[i, j]):
+                cnt += 1
+                st += t[i, j]
+                sp += probe[i, j]
+    if cnt <= 3:
+        return
+    mt = st / cnt
+    mp = sp / cnt
+    vt = 0.0
+    vp = 0.0
+    for i in range(t.shape[0]):
+        for j in range(t.shape[1]):
+            if np.isfinite(probe[i, j]):
+                vt += (t[i, j] - mt) ** 2
+                vp += (probe[i, j] - mp) ** 2
+    if vp > 0:
+        r1 = math.sqrt(vt / cnt) / math.sqrt(vp / cnt)
+        r[0] = mt - r1 * mp
+        r[1] = r1
+
+
+@njit
+def _window(image, cx, cy, radius):
+    """:func:`_crop` in a kernel: (float64 window or an empty one, x offset, y offset, all finite)."""
+    h, w = image.shape
+    rr = int(math.ceil(radius)) + 2
+    x0 = max(0, int(math.floor(cx)) - rr)
+    y0 = max(0, int(math.floor(cy)) - rr)
+    x1 = min(w, int(math.floor(cx)) + rr + 2)
+    y1 = min(h, int(math.floor(cy)) + rr + 2)
+    if x1 - x0 < 3 or y1 - y0 < 3:
+        return np.empty((0, 0)), x0, y0, True
+    win = np.empty((y1 - y0, x1 - x0))
+    finite = True
+    for i in range(y1 - y0):
+        for j in range(x1 - x0):
+            v = float(image[y0 + i, x0 + j])
+            win[i, j] = v
+            if not np.isfinite(v):
+                finite = False
+    return win, x0, y0, finite
+
+
+@njit
+def _match_many(templates, tindex, image, starts, shapes, idx, n_shape, max_iter, tol, max_shift, out):
+    """Single-stage LSM of ``templates[tindex[k]]`` into ``image`` from ``starts[k]`` with the
+    shaping started at ``shapes[k]`` (2, 2). ``out`` (K, 6): x, y, sigma_x, sigma_y, correlation,
+    status (:data:`_REASONS`)."""
+    th = templates.shape[1]
+    tw = templates.shape[2]
+    hv = th // 2
+    hu = tw // 2
+    h, w = image.shape
+    m = idx.shape[0]
+    inv = np.empty((m, m))
+    res = np.empty((th, tw))
+    probe = np.empty((th, tw))
+    Nd = np.empty((10, 10))
+    bd = np.empty(10)
+    pc = np.zeros(10)
+    r = np.empty(2)
+    for k in range(starts.shape[0]):
+        t = templates[tindex[k]]
+        x = starts[k, 0]
+        y = starts[k, 1]
+        for c in range(5):
+            out[k, c] = np.nan
+        if not (x >= 0 and y >= 0 and x <= w - 1 and y <= h - 1):
+            out[k, 5] = 6
+            continue
+        pc[:] = 0.0
+        pc[0] = shapes[k, 0, 0]
+        pc[1] = shapes[k, 0, 1]
+        pc[2] = shapes[k, 1, 0]
+        pc[3] = shapes[k, 1, 1]
+        reach = max(abs(pc[0]) + abs(pc[1]), abs(pc[2]) + abs(pc[3])) * max(hu, hv)
+        window, ox, oy, finite = _window(image, x, y, reach + max_shift + 2.0)
+        if window.shape[0] == 0:
+            out[k, 5] = 6
+            continue
+        if not finite:
+            out[k, 5] = 7
+            continue
+        gx = np.empty(window.shape)
+        gy = np.empty(window.shape)
+        _gradients_k(window, gx, gy)
+        pc[8] = x - ox
+        pc[9] = y - oy
+        _normals(t, window, gx, gy, pc, 0.0, 1.0, Nd, bd, probe)
+        r[0] = 0.0
+        r[1] = 1.0
+        _radiometric_start(t, probe, r)
+        status, _it, ssr, n = _lm_stage(
+            t, window, gx, gy, pc, r, idx, n_shape, max_iter, tol, max_shift, ox, oy, x, y, inv, res
+        )
+        out[k, 0] = pc[8] + ox
+        out[k, 1] = pc[9] + oy
+        out[k, 5] = status
+        if status:
+            continue
+        s2 = ssr / max(n - m, 1)
+        out[k, 2] = math.sqrt(max(s2 * inv[m - 2, m - 2], 0.0))
+        out[k, 3] = math.sqrt(max(s2 * inv[m - 1, m - 1], 0.0))
+        out[k, 4] = _ncc_k(t, res)
+
+
+@njit
+def _extract_many(image, centres, out):
+    """Templates ``out`` (K, n, n) of ``image`` centred bilinearly on ``centres`` (K, 2); NaN
+    where a template reaches outside the image or onto non-finite values."""
+    n = out.shape[1]
+    half = n // 2
+    zeros = np.zeros((n, n))
+    N = np.empty((10, 10))
+    b = np.empty(10)
+    p = np.zeros(10)
+    for k in range(centres.shape[0]):
+        x = centres[k, 0]
+        y = centres[k, 1]
+        out[k, :, :] = np.nan
+        if not (np.isfinite(x) and np.isfinite(y)):
+            continue
+        window, ox, oy, finite = _window(image, x, y, half + 2)
+        if window.shape[0] == 0 or not finite:
+            continue
+        p[:] = 0.0
+        p[0] = 1.0
+        p[3] = 1.0
+        p[8] = x - ox
+        p[9] = y - oy
+        _normals(zeros, window, window, window, p, 0.0, 1.0, N, b, out[k])
+
+
+@njit
+def _plane_shapes(X, normals, master, view, R, C, P, out):
+    """:func:`plane_shape` for many (point, master, view): ``out`` (K, 2, 2)."""
+    uv0 = np.empty(2)
+    q = np.empty((4, 2))
+    d = np.empty(3)
+    pt = np.empty(3)
+    for k in range(X.shape[0]):
+        mi = master[k]
+        vi = view[k]
+        out[k, :, :] = np.nan
+        _project_one(X[k], R[mi], C[mi], P[mi], uv0)
+        if not (np.isfinite(uv0[0]) and np.isfinite(uv0[1])):
+            continue
+        num = 0.0
+        for c in range(3):
+            num += (X[k, c] - C[mi, c]) * normals[k, c]
+        for j in range(4):
+            du = 1.0 if j == 0 else (-1.0 if j == 1 else 0.0)
+            dv = 1.0 if j == 2 else (-1.0 if j == 3 else 0.0)
+            x, y, ok = _undistort_one(uv0[0] + du, uv0[1] + dv, P[mi], 20)
+            if not ok:
+                q[j, 0] = np.nan
+                q[j, 1] = np.nan
+                continue
+            den = 0.0
+            for c in range(3):
+                d[c] = x * R[mi, 0, c] + y * R[mi, 1, c] + R[mi, 2, c]
+                den += d[c] * normals[k, c]
+            if den == 0.0:
+                q[j, 0] = np.nan
+                q[j, 1] = np.nan
+                continue
+            lam = num / den
+            for c in range(3):
+                pt[c] = C[mi, c] + lam * d[c]
+            _project_one(pt, R[vi], C[vi], P[vi], q[j])
+        out[k, 0, 0] = (q[0, 0] - q[1, 0]) / 2.0
+        out[k, 1, 0] = (q[0, 1] - q[1, 1]) / 2.0
+        out[k, 0, 1] = (q[2, 0] - q[3, 0]) / 2.0
+        out[k, 1, 1] = (q[2, 1] - q[3, 1]) / 2.0
+
+
+# ---------------------------------------------------------------- LSM
+
+
+def _lsm_stage(t, window, ox, oy, p, r, cfg, start, it0):
+    """Levenberg-Marquardt iterations on one (possibly blurred) stage (:func:`_lm_stage`).
+
+    Returns ``(p, r, it, reason, extras)``; a step that does not lower the residuals is retried
+    with more damping (symmetric targets otherwise make the shaping oscillate).
+    """
+    gx, gy = _gradients(window)
+    local = _PROJECTIVE_LOCAL if cfg.projective else _AFFINE_LOCAL
+    idx = np.concatenate([local, _SHIFT])
+    m = len(idx)
+    pc = p.copy()
+    pc[8] -= ox
+    pc[9] -= oy
+    rr = np.array(r, dtype=np.float64)
+    inv = np.zeros((m, m))
+    res = np.zeros(t.shape)
+    status, k, ssr, n = _lm_stage(
+        np.ascontiguousarray(t, dtype=np.float64),
+        window,
+        gx,
+        gy,
+        pc,
+        rr,
+        idx,
+        len(local) - 2,
+        cfg.max_iterations,
+        float(cfg.tolerance),
+        float(cfg.max_shift),
+        float(ox),
+        float(oy),
+        float(start[0]),
+        float(start[1]),
+        inv,
+        res,
+    )
+    it = it0 + int(k)
+    r = (float(rr[0]), float(rr[1]))
+    if status:
+        return pc, r, it, _REASONS[int(status)], None
+    pc[8] += ox
+    pc[9] += oy
+    return pc, r, it, "", (float(ssr), int(n), m, inv, res)
 
 
 def lsm_match(
@@ -556,6 +895,109 @@ def extract_template(image, x: float, y: float, half_size: int) -> np.ndarray:
     return out
 
 
+@dataclass(frozen=True)
+class LsmMatches:
+    """Outcome of :func:`lsm_match_many`, one row per match.
+
+    ``xy`` (K, 2) and ``sigma`` (K, 2): the template centre in the image and its standard
+    deviations (pixels); ``correlation`` (K,); ``converged`` (K,) bool (converged with at least
+    the configured correlation); ``reason`` (K,) str, empty where converged.
+    """
+
+    xy: np.ndarray
+    sigma: np.ndarray
+    correlation: np.ndarray
+    converged: np.ndarray
+    reason: np.ndarray
+
+
+def lsm_match_many(
+    templates, image, starts, shapes=None, config: LsmConfig | None = None, template_index=None
+) -> LsmMatches:
+    """:func:`lsm_match` of many templates into one image in one compiled loop.
+
+    The same estimation as :func:`lsm_match` with ``initial`` a (2, 2) shaping, for the
+    single-stage case (``config.coarse_sigma`` must be 0). The image is read as given (any real
+    dtype; only the windows around the starts are converted), templates are not checked for
+    contrast (a constant one gives "singular").
+
+    Parameters
+    ----------
+    templates : (T, h, w) array, h and w odd
+    image : (H, W) array
+    starts : (K, 2) float
+        Start of every match, pixels.
+    shapes : (K, 2, 2) float, optional
+        Start of every shaping (template offsets -> pixels). Default: identity.
+    config : LsmConfig, optional
+    template_index : (K,) int, optional
+        The template of every match (default: match k uses template k; then T == K). Templates
+        no match uses are not read (they may hold NaN).
+
+    Returns
+    -------
+    LsmMatches
+    """
+    cfg = config or LsmConfig(coarse_sigma=0.0)
+    if cfg.coarse_sigma != 0:
+        raise InputError("lsm_match_many: config.coarse_sigma must be 0 (single stage)")
+    tm = np.ascontiguousarray(templates, dtype=np.float64)
+    if tm.ndim != 3 or tm.shape[1] % 2 == 0 or tm.shape[2] % 2 == 0 or min(tm.shape[1:]) < 3:
+        raise InputError(f"lsm_match_many: templates must be (T, h, w) with h, w odd, got {tm.shape}")
+    img = _image(image, "image")
+    st = np.ascontiguousarray(starts, dtype=np.float64).reshape(-1, 2)
+    k = len(st)
+    if shapes is None:
+        sh = np.tile(np.eye(2), (k, 1, 1))
+    else:
+        sh = np.ascontiguousarray(shapes, dtype=np.float64)
+    ti = np.arange(k) if template_index is None else np.asarray(template_index).astype(np.int64)
+    if sh.shape != (k, 2, 2) or ti.shape != (k,):
+        raise InputError(f"lsm_match_many: {k} starts need (K, 2, 2) shapes and (K,) template indices")
+    if k and (ti.min() < 0 or ti.max() >= len(tm)):
+        raise InputError(f"lsm_match_many: template indices must be in [0, {len(tm)})")
+    if not (np.all(np.isfinite(st)) and np.all(np.isfinite(sh))):
+        raise InputError("lsm_match_many: starts and shapes must be finite")
+    if k and not np.all(np.isfinite(tm[np.unique(ti)])):
+        raise InputError("lsm_match_many: a template used contains NaN or infinite values")
+    local = _PROJECTIVE_LOCAL if cfg.projective else _AFFINE_LOCAL
+    out = np.empty((k, 6))
+    _match_many(
+        tm,
+        ti,
+        img,
+        st,
+        sh,
+        np.concatenate([local, _SHIFT]),
+        len(local) - 2,
+        cfg.max_iterations,
+        float(cfg.tolerance),
+        float(cfg.max_shift),
+        out,
+    )
+    status = out[:, 5].astype(np.int64)
+    corr = out[:, 4]
+    ok = (status == 0) & (corr >= cfg.min_correlation)
+    reason = np.array([_REASONS[c] for c in status], dtype=object)
+    reason[(status == 0) & ~ok] = "low correlation"
+    return LsmMatches(out[:, :2].copy(), out[:, 2:4].copy(), corr.copy(), ok, reason)
+
+
+def extract_templates(image, centres, half_size: int) -> np.ndarray:
+    """:func:`extract_template` at many centres: (K, n, n) with ``n = 2 half_size + 1``, all NaN
+    for a template that reaches outside the image (or onto NaN values) instead of raising."""
+    img = _image(image, "image")
+    if not (isinstance(half_size, int | np.integer) and half_size >= 1):
+        raise InputError(f"half_size must be a positive integer, got {half_size!r}")
+    c = np.ascontiguousarray(centres, dtype=np.float64).reshape(-1, 2)
+    n = 2 * int(half_size) + 1
+    out = np.empty((len(c), n, n))
+    _extract_many(img, c, out)
+    bad = ~np.all(np.isfinite(out.reshape(len(c), -1)), axis=1)
+    out[bad] = np.nan
+    return out
+
+
 # ---------------------------------------------------------------- MGCM
 
 
@@ -629,6 +1071,30 @@ def plane_shape(master: MgcmView, view: MgcmView, X, normal=(0.0, 0.0, 1.0)) -> 
     pts = Cm[None] + lam[:, None] * d
     q = project_points(pts, view.R, view.C, view.camera)
     return np.column_stack([(q[0] - q[1]) / 2.0, (q[2] - q[3]) / 2.0])
+
+
+def plane_shapes(points, normals, master, view, rotations, centers, cameras) -> np.ndarray:
+    """:func:`plane_shape` for many (point, master image, view image) triples in one loop.
+
+    ``points``, ``normals`` (K, 3) local frame; ``master``, ``view`` (K,) image indices into
+    ``rotations`` (N, 3, 3), ``centers`` (N, 3) and ``cameras`` (N Camera). Returns (K, 2, 2),
+    NaN where a ray misses the plane or a point is behind a camera.
+    """
+    X = np.ascontiguousarray(points, dtype=np.float64).reshape(-1, 3)
+    nrm = np.ascontiguousarray(normals, dtype=np.float64).reshape(-1, 3)
+    mi = np.asarray(master).astype(np.int64).reshape(-1)
+    vi = np.asarray(view).astype(np.int64).reshape(-1)
+    R = np.ascontiguousarray(rotations, dtype=np.float64).reshape(-1, 3, 3)
+    C = np.ascontiguousarray(centers, dtype=np.float64).reshape(-1, 3)
+    P = np.ascontiguousarray([c.params for c in cameras], dtype=np.float64).reshape(-1, 9)
+    k = len(X)
+    if not (len(nrm) == len(mi) == len(vi) == k and len(R) == len(C) == len(P)):
+        raise InputError("plane_shapes: points, normals, master and view must have the same length")
+    if k and (min(mi.min(), vi.min()) < 0 or max(mi.max(), vi.max()) >= len(R)):
+        raise InputError(f"plane_shapes: image indices must be in [0, {len(R)})")
+    out = np.empty((k, 2, 2))
+    _plane_shapes(X, nrm, mi, vi, R, C, P, out)
+    return out
 
 
 def mgcm(

@@ -2,11 +2,16 @@
 
 For every tie point, the observation nearest its image's principal point is the *master*: a
 template is cut around it (at the working resolution of the images given) and matched by LSM
-(:func:`~.lsm.lsm_match`, affine shaping and gain/offset) into every other image that observes
-the point, starting at that image's own observation, with the shaping started from the geometry
-(:func:`~.lsm.plane_shape` on the plane through the point facing the master camera). Matches
-that converge with a high correlation, a small move and a small standard deviation replace the
-observation; the others keep it. The master observation defines the point and is unchanged.
+(the estimation of :func:`~.lsm.lsm_match`, affine shaping and gain/offset) into every other
+image that observes the point, starting at that image's own observation, with the shaping started
+from the geometry (:func:`~.lsm.plane_shape` on the plane through the point facing the master
+camera). Matches that converge with a high correlation, a small move and a small standard
+deviation replace the observation; the others keep it. The master observation defines the point
+and is unchanged.
+
+Cost: the templates are cut per master image and the matches run per search image in compiled
+loops (:func:`~.lsm.extract_templates`, :func:`~.lsm.plane_shapes`, :func:`~.lsm.lsm_match_many`);
+bench/bench_tiepoints.py prints the wall time with the accuracy figures.
 
 The collinearity-constrained MGCM is deliberately not used here: its image coordinates are the
 projections of one object point through the current orientation, so feeding them back into the
@@ -23,7 +28,7 @@ import numpy as np
 
 from ..errors import CancelledError, InputError
 from ..progress import Progress, as_progress
-from .lsm import LsmConfig, MgcmView, extract_template, lsm_match, plane_shape
+from .lsm import LsmConfig, extract_templates, lsm_match_many, plane_shapes
 
 
 @dataclass(frozen=True)
@@ -97,7 +102,7 @@ def refine_tie_points(
         Per image the factors ``(sx, sy)`` from full resolution to the working resolution.
     config : TieRefineConfig, optional
     progress : Progress, optional
-        Cancel is checked every few hundred points.
+        Cancel is checked before every search image.
 
     Returns
     -------
@@ -113,87 +118,81 @@ def refine_tie_points(
         )
     if not np.all(np.isfinite(sc)) or np.any(sc <= 0):
         raise InputError("refine_tie_points: scales must be positive")
-    views = []
-    for i in range(n_img):
-        cam = block.cameras[int(block.image_camera[i])]
-        views.append(
-            MgcmView(
-                images[i],
-                block.rotations[i],
-                block.centers[i],
-                cam.scaled(float(sc[i, 0]), float(sc[i, 1])),
-                str(i),
-            )
-        )
-    obs_xy = np.array(block.obs_xy, dtype=np.float64, copy=True)
-    refined = np.zeros(len(obs_xy), dtype=bool)
-    sigma = np.full((len(obs_xy), 2), np.nan)
-    order = np.argsort(block.obs_point, kind="stable")
-    starts = np.flatnonzero(np.r_[True, np.diff(block.obs_point[order]) != 0, True])
+    cams = [
+        block.cameras[int(block.image_camera[i])].scaled(float(sc[i, 0]), float(sc[i, 1]))
+        for i in range(n_img)
+    ]
+    obs_img = np.asarray(block.obs_image, dtype=np.int64)
+    obs_pt = np.asarray(block.obs_point, dtype=np.int64)
+    obs_xy = np.array(block.obs_xy, dtype=np.float64, copy=True).reshape(-1, 2)
+    n_obs = len(obs_xy)
+    refined = np.zeros(n_obs, dtype=bool)
+    sigma = np.full((n_obs, 2), np.nan)
     lsm_cfg = LsmConfig(coarse_sigma=0.0, max_shift=cfg.max_shift, min_correlation=cfg.min_correlation)
-    tried = failed_template = 0
+    # every observation at the working resolution
+    xw = (obs_xy + 0.5) * sc[obs_img] - 0.5
+    geom = np.array([(c.cx, c.cy, c.width, c.height) for c in cams], dtype=np.float64).reshape(-1, 4)[obs_img]
+    off = np.hypot((xw[:, 0] - geom[:, 0]) / geom[:, 2], (xw[:, 1] - geom[:, 1]) / geom[:, 3])
+    # master of every point: the observation nearest its camera's principal point (least
+    # distortion, most frontal); ties to the first observation
+    order = np.lexsort((np.arange(n_obs), off, obs_pt))
+    first = np.flatnonzero(np.r_[True, np.diff(obs_pt[order]) != 0]) if n_obs else np.zeros(0, int)
+    n_pts = len(first)
+    counts = np.diff(np.r_[first, n_obs])
+    masters = order[first[counts >= 2]]  # points seen at least twice
+    # templates, cut per master image
+    half = cfg.half_size
+    templates = np.full((len(masters), 2 * half + 1, 2 * half + 1), np.nan)
+    m_img = obs_img[masters]
+    for i in np.unique(m_img):
+        sel = np.flatnonzero(m_img == i)
+        templates[sel] = extract_templates(images[i], xw[masters[sel]], half)
+    flat = templates.reshape(len(masters), (2 * half + 1) ** 2)
+    with np.errstate(invalid="ignore"):
+        good = np.all(np.isfinite(flat), axis=1) & (
+            np.std(flat, axis=1) > 1e-6 * np.maximum(1.0, np.abs(flat).max(axis=1, initial=0.0))
+        )
+    failed_template = int((~good).sum())
+    # the other observations of the points with a template
+    slot = np.full(int(obs_pt.max()) + 1 if n_obs else 0, -1, dtype=np.int64)
+    slot[obs_pt[masters[good]]] = np.flatnonzero(good)
+    is_master = np.zeros(n_obs, dtype=bool)
+    is_master[masters] = True
+    cand = np.flatnonzero((slot[obs_pt] >= 0) & ~is_master) if n_obs else np.zeros(0, int)
+    tslot = slot[obs_pt[cand]]
+    mi = obs_img[masters[tslot]]
+    X = np.asarray(block.points, dtype=np.float64)[obs_pt[cand]]
+    centers = np.asarray(block.centers, dtype=np.float64)
+    shapes = plane_shapes(X, X - centers[mi], mi, obs_img[cand], block.rotations, centers, cams)
+    finite = np.all(np.isfinite(shapes.reshape(-1, 4)), axis=1)
+    cand, tslot, shapes = cand[finite], tslot[finite], shapes[finite]
+    tried = len(cand)
     moves = []
-    n_pts = len(starts) - 1
-    for k in range(n_pts):
-        if k % 500 == 0:
-            if prog.cancelled():
-                raise CancelledError("cancelled by the user")
-            prog.update(k / max(n_pts, 1), f"refining tie points: {k} of {n_pts}")
-        idx = order[starts[k] : starts[k + 1]]
-        if len(idx) < 2:
-            continue
-        X = block.points[int(block.obs_point[idx[0]])]
-        # master: the observation nearest its camera's principal point (least distortion, most frontal)
-        off = []
-        for o in idx:
-            cam = views[int(block.obs_image[o])].camera
-            i = int(block.obs_image[o])
-            xw = (obs_xy[o] + 0.5) * sc[i] - 0.5
-            off.append(math.hypot((xw[0] - cam.cx) / cam.width, (xw[1] - cam.cy) / cam.height))
-        m = int(idx[int(np.argmin(off))])
-        mi = int(block.obs_image[m])
-        mxy = (obs_xy[m] + 0.5) * sc[mi] - 0.5
-        try:
-            tmpl = extract_template(views[mi].image, float(mxy[0]), float(mxy[1]), cfg.half_size)
-        except InputError:
-            failed_template += 1
-            continue
-        if float(np.std(tmpl)) <= 1e-6 * max(1.0, float(np.abs(tmpl).max())):
-            failed_template += 1
-            continue
-        normal = X - block.centers[mi]
-        for o in idx:
-            if o == m:
-                continue
-            i = int(block.obs_image[o])
-            A = plane_shape(views[mi], views[i], X, normal=normal)
-            if not np.all(np.isfinite(A)):
-                continue
-            start = (obs_xy[o] + 0.5) * sc[i] - 0.5
-            tried += 1
-            r = lsm_match(
-                tmpl,
-                views[i].image,
-                float(start[0]),
-                float(start[1]),
-                lsm_cfg,
-                initial=np.column_stack([A, [0, 0]]),
-            )
-            if not r.converged or max(r.sigma_x, r.sigma_y) > cfg.max_sigma:
-                continue
-            new = (np.array([r.x, r.y]) + 0.5) / sc[i] - 0.5
-            moves.append(float(np.hypot(*(new - obs_xy[o]))))
-            obs_xy[o] = new
-            sigma[o] = (r.sigma_x / sc[i, 0], r.sigma_y / sc[i, 1])
-            refined[o] = True
+    search = obs_img[cand]
+    todo = np.unique(search)
+    for step, i in enumerate(todo):
+        if prog.cancelled():
+            raise CancelledError("cancelled by the user")
+        prog.update(step / max(len(todo), 1), f"refining tie points: image {step + 1} of {len(todo)}")
+        sel = np.flatnonzero(search == i)
+        o = cand[sel]
+        r = lsm_match_many(templates, images[i], xw[o], shapes[sel], lsm_cfg, template_index=tslot[sel])
+        ok = r.converged & np.all(r.sigma <= cfg.max_sigma, axis=1)
+        o, xy, sg = o[ok], r.xy[ok], r.sigma[ok]
+        new = (xy + 0.5) / sc[i] - 0.5
+        moves.append(np.hypot(*(new - obs_xy[o]).T))
+        obs_xy[o] = new
+        sigma[o] = sg / sc[i]
+        refined[o] = True
+    moves_all = np.concatenate(moves) if moves else np.zeros(0)
     prog.update(1.0, f"refined {int(refined.sum())} of {tried} tie-point observations")
     stats = {
         "points": n_pts,
-        "observations": len(obs_xy),
+        "observations": n_obs,
         "tried": tried,
         "refined": int(refined.sum()),
         "no_template": failed_template,
-        "median_move_px": float(np.median(moves)) if moves else float("nan"),
+        "median_move_px": float(np.median(moves_all)) if len(moves_all) else float("nan"),
         "median_sigma_px": float(np.nanmedian(sigma[refined])) if refined.any() else float("nan"),
     }
     return TieRefinement(obs_xy, refined, sigma, stats)

@@ -7,7 +7,17 @@ import numpy as np
 import pytest
 
 from truortho.core.errors import InputError
-from truortho.core.gcp.lsm import LsmConfig, MgcmView, extract_template, lsm_match, mgcm, plane_shape
+from truortho.core.gcp.lsm import (
+    LsmConfig,
+    MgcmView,
+    extract_template,
+    extract_templates,
+    lsm_match,
+    lsm_match_many,
+    mgcm,
+    plane_shape,
+    plane_shapes,
+)
 from truortho.core.geometry import project_points
 from truortho.core.synthetic.cameras import look_at_rotation, make_camera, nadir_rotation
 from truortho.core.synthetic.targets import disc_pattern, render_homography, render_on_plane
@@ -137,3 +147,46 @@ def test_mgcm_bad_input_and_failure(block):
         extract_template(views[0].image, 2.0, 2.0, 10)
     A = plane_shape(views[0], views[0], Xt)
     np.testing.assert_allclose(A, np.eye(2), atol=1e-6)
+
+
+def test_batched_matching_equals_one_by_one(block):
+    """lsm_match_many, extract_templates and plane_shapes (the compiled loops of the tie-point
+    refinement) give what lsm_match, extract_template and plane_shape give one at a time,
+    including the failures."""
+    views, Xt, truth = block
+    rng = np.random.default_rng(12)
+    X = Xt + np.column_stack([rng.uniform(-1.5, 1.5, (12, 2)), np.zeros(12)])
+    master = views[0]
+    uv_m = project_points(X, master.R, master.C, master.camera)
+    centres = np.vstack([uv_m, [[2.0, 2.0]]])  # the last one reaches outside the image
+    tm = extract_templates(master.image, centres, 7)
+    assert np.all(np.isnan(tm[-1])) and np.all(np.isfinite(tm[:-1]))
+    for k in range(len(X)):
+        np.testing.assert_array_equal(tm[k], extract_template(master.image, *centres[k], 7))
+    cfg = LsmConfig(coarse_sigma=0.0, max_shift=1.5, min_correlation=0.8)
+    cams = [v.camera for v in views]
+    Rs = np.array([v.R for v in views])
+    Cs = np.array([v.C for v in views])
+    for j in (1, 2, 3):
+        v = views[j]
+        nrm = X - master.C
+        A = plane_shapes(X, nrm, np.zeros(len(X), int), np.full(len(X), j), Rs, Cs, cams)
+        for k in range(len(X)):
+            one = plane_shape(master, v, X[k], normal=nrm[k])
+            np.testing.assert_allclose(A[k], one, rtol=1e-9, atol=1e-12)
+        starts = project_points(X, v.R, v.C, v.camera) + rng.normal(0, 0.6, (len(X), 2))
+        starts[0] = (-5.0, 10.0)  # outside the image
+        starts[1] += 4.0  # too far for max_shift
+        r = lsm_match_many(tm, v.image, starts, A, cfg, template_index=np.arange(len(X)))
+        for k in range(len(X)):
+            one = lsm_match(tm[k], v.image, *starts[k], cfg, initial=np.column_stack([A[k], [0, 0]]))
+            assert bool(r.converged[k]) == one.converged and r.reason[k] == one.reason, (k, one.reason)
+            if one.converged:
+                np.testing.assert_allclose(r.xy[k], [one.x, one.y], atol=1e-9)
+                np.testing.assert_allclose(r.sigma[k], [one.sigma_x, one.sigma_y], rtol=1e-6)
+                assert abs(r.correlation[k] - one.correlation) < 1e-9
+        assert r.converged.sum() >= len(X) // 2 and "outside" in r.reason[0] and not r.converged[1]
+    with pytest.raises(InputError, match="coarse_sigma"):
+        lsm_match_many(tm[:2], views[1].image, uv_m[:2], config=LsmConfig())
+    with pytest.raises(InputError, match="NaN"):  # a template used that is all NaN
+        lsm_match_many(tm, views[1].image, uv_m[:1], config=cfg, template_index=[len(X)])
