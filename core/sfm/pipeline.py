@@ -411,44 +411,53 @@ def reconstruct_block(
         inc.refine_focal_early = False
     elif camera_file:
         inc.refine_focal_early = False
+    sel = matches.selection
+    # a second matching pass may follow: the final adjustments wait for it (made once, at the end)
+    may_retry = sel.strategy != "exhaustive"
     rec = reconstruct(
-        tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, steps[1], features, tracks.feature
+        tracks.track,
+        tracks.image,
+        tracks.xy,
+        image_camera,
+        cams,
+        inc,
+        steps[1],
+        features,
+        tracks.feature,
+        finalize=not may_retry,
     )
     missing = np.flatnonzero(~rec.registered)
-    sel = matches.selection
-    if len(missing) and sel.strategy != "exhaustive" and rec.registered.sum() >= 2:
+    extra = []
+    if len(missing) and may_retry and rec.registered.sum() >= 2:
         # second chance: match the images left out against every image not paired with them yet
         tried = {(int(a), int(b)) for a, b in sel.pairs}
         extra = sorted(
             {(min(int(m), j), max(int(m), j)) for m in missing for j in range(len(paths)) if j != m} - tried
         )
-        if extra:
-            check(prog)
-            prog.update(
-                0.85, f"matching {len(missing)} unregistered image(s) against all others ({len(extra)} pairs)"
-            )
-            more, _ = match_pairs(features, np.array(extra), matches.per_image_cams)
-            results = results + more
-            n_verified = sum(r.ok for r in results)
-            tracks2 = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)
-            rec2 = reconstruct(
-                tracks2.track,
-                tracks2.image,
-                tracks2.xy,
-                image_camera,
-                cams,
-                inc,
-                None,
-                features,
-                tracks2.feature,
-            )
-            if rec2.registered.sum() > rec.registered.sum():
-                rec, tracks = rec2, tracks2
-            registered_after = int(rec.registered.sum())
-            warnings.append(
-                f"second matching pass for {len(missing)} image(s): {len(extra)} more pairs, "
-                f"{registered_after} images registered"
-            )
+    if extra:
+        check(prog)
+        prog.update(
+            0.85, f"matching {len(missing)} unregistered image(s) against all others ({len(extra)} pairs)"
+        )
+        more, _ = match_pairs(features, np.array(extra), matches.per_image_cams)
+        results = results + more
+        n_verified = sum(r.ok for r in results)
+        tracks = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)
+        # go on from the block registered so far (its poses; every track triangulated anew)
+        rec = reconstruct(
+            tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, None, features, tracks.feature,
+            start=rec,
+        )  # fmt: skip
+        warnings.append(
+            f"second matching pass for {len(missing)} image(s): {len(extra)} more pairs, "
+            f"{int(rec.registered.sum())} images registered"
+        )
+    elif not rec.stats.get("finalized", True):
+        # its own observations (with those guided registration added): points and inliers are kept
+        rec = reconstruct(
+            rec.obs_track, rec.obs_image, rec.obs_xy, image_camera, cams, inc, None, features,
+            rec.obs_feature, start=rec, register=False,
+        )  # fmt: skip
     times["reconstruction"] = time.perf_counter() - t
     n_reg = int(rec.registered.sum())
     if n_reg < 2:

@@ -72,3 +72,37 @@ def test_images_without_overlap_stay_unregistered():
     xy = np.concatenate([xy, rng.uniform(0, 800, (50, 2))])
     rec = reconstruct(tr, im, xy, np.zeros(6, int), [cam])
     assert rec.registered[:5].all() and not rec.registered[5]
+
+
+def _centre_rmse(rec, Cs, images):
+    sim = estimate_similarity(rec.centers[images], Cs[images])
+    return float(np.sqrt(np.mean(np.linalg.norm(sim.apply(rec.centers[images]) - Cs[images], axis=1) ** 2)))
+
+
+def test_second_pass_resumes_the_first_reconstruction():
+    """``finalize=False`` then ``start=``: the images a first pass could not link (here the third
+    strip, whose observations it does not get) join the block registered so far, and the result
+    is as accurate as one reconstruction from all observations; ``register=False`` only finalizes."""
+    cam, Rs, Cs, X, tr, im, xy = synthetic_tracks(seed=2)
+    prior = Camera(cam.width, cam.height, 1080.0, 1080.0, 599.5, 399.5)
+    cams, n = [prior], len(Rs)
+    first = im < 12
+    rec1 = reconstruct(tr[first], im[first], xy[first], np.zeros(n, int), cams, finalize=False)
+    assert rec1.registered[:12].all() and not rec1.registered[12:].any()
+    assert rec1.stats["finalized"] is False and "final_bundle" not in rec1.stats
+    rec2 = reconstruct(tr, im, xy, np.zeros(n, int), cams, start=rec1)
+    assert rec2.registered.all() and rec2.stats["finalized"] is True
+    assert [a.get("resumed") for a in rec2.stats["adjustments"]].count(True) == 1
+    whole = reconstruct(tr, im, xy, np.zeros(n, int), cams)
+    all_images = np.arange(n)
+    assert _centre_rmse(rec2, Cs, all_images) < 0.1
+    assert _centre_rmse(rec2, Cs, all_images) < 1.5 * _centre_rmse(whole, Cs, all_images) + 0.01
+    assert abs(rec2.intrinsics[0, 0] - cam.fx) < 5.0
+    # only finalize: the same observations, points and registrations kept, then adjusted
+    done = reconstruct(
+        rec1.obs_track, rec1.obs_image, rec1.obs_xy, np.zeros(n, int), cams, start=rec1, register=False
+    )
+    assert np.array_equal(done.registered, rec1.registered) and done.stats["finalized"] is True
+    assert _centre_rmse(done, Cs, np.arange(12)) < 0.1
+    with pytest.raises(InputError, match="another block"):
+        reconstruct(tr, im, xy, np.zeros(n + 1, int), cams, start=rec1)
