@@ -9,7 +9,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source scripts/env.sh &&
 
-.PHONY: setup test lint pytest demo bench acceptance acceptance-real zip docs
+.PHONY: setup test lint pytest demo bench acceptance acceptance-ablation acceptance-real zip docs
 
 setup:
 	bash scripts/setup.sh
@@ -47,6 +47,11 @@ bench: setup
 # make acceptance ACCEPTANCE_ARGS="--only 3,7 --no-sgbm"; --write-docs updates docs/acceptance.md.
 acceptance: setup
 	$(ENV) $(PY) -P bench/acceptance.py $(ACCEPTANCE_ARGS)
+
+# The battery's true-ortho goals against the images' own defects: the same scenes re-rendered without
+# JPEG, noise and radiometric jitter (ACCEPTANCE_ARGS as above; about 10 minutes).
+acceptance-ablation: setup
+	$(ENV) $(PY) -P bench/acceptance_ablation.py $(ACCEPTANCE_ARGS)
 
 # Real photo blocks through the whole pipeline (no truth DSM): make acceptance-real REAL_ARGS="--blocks sample,brighton"
 acceptance-real: setup

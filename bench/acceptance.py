@@ -509,8 +509,9 @@ def scene_table(rows: list[dict]) -> list[str]:
     return lines
 
 
-def write_docs(text: str) -> None:
-    begin, end = "<!-- acceptance:begin -->", "<!-- acceptance:end -->"
+def write_docs(text: str, section: str = "acceptance") -> None:
+    """Replace the marked ``section`` of docs/acceptance.md with ``text``."""
+    begin, end = f"<!-- {section}:begin -->", f"<!-- {section}:end -->"
     doc = (
         open(DOCS, encoding="utf-8").read()
         if os.path.exists(DOCS)
