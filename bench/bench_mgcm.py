@@ -15,9 +15,9 @@ in the same run on the same images:
   independent LSM per view;
 * ArUco markers: detection rate and centre accuracy, LSM-refined centre against the diagonal
   intersection of OpenCV's sub-pixel corners;
-* with ``--orientation`` (about 15 minutes, so not by default): ``orient_images`` on the synthetic
-  nadir+oblique block with and without LSM refinement of the tie points (sigma0, check RMSE).
-  Measured once (seed 3): sigma0 0.170 -> 0.119 px, check RMSE 3-D 0.055 -> 0.056 m (unchanged).
+* with ``--orientation`` (not by default): ``orient_images`` on one synthetic nadir+oblique block
+  with and without LSM refinement of the tie points (sigma0, check RMSE); bench_tiepoints.py
+  (``make bench BENCH=tiepoints``) compares them on several blocks and copr, camera errors included.
 
 The goal of issue 19: refined target positions within 0.1 px RMS from starts up to 3 px off.
 """
@@ -335,7 +335,7 @@ def main() -> None:
     ap.add_argument(
         "--orientation",
         action="store_true",
-        help="also orient a synthetic block with and without tie-point refinement (about 15 min)",
+        help="also orient a synthetic block with and without tie-point refinement",
     )
     a = ap.parse_args()
     t0 = time.perf_counter()
