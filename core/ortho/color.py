@@ -14,6 +14,15 @@ applied to its samples before they enter the mosaic:
 * any other band count (panchromatic, thermal, multispectral): the equivalent
   per-band linear model in the data's own units.
 
+Vignetting (:func:`estimate_vignetting`): before the gains and offsets, a radial
+fall-off per camera, ``V(rho) = exp(c1 rho^2 + c2 rho^4)`` with ``rho`` the distance from the
+principal point over the half diagonal, applied in linear light (sRGB decoded; other data as
+given): a sample is divided by ``V``. It is estimated from the same cells: for every pair of
+observations of a cell, ``log Y_a - log Y_b = u_a - u_b + log V_A(rho_a) - log V_B(rho_b)``
+(``Y`` linear luminance, ``u`` a log exposure per image, ``A``/``B`` the cameras), solved by
+Huber-reweighted least squares; a camera whose fit is poorly determined (its observations span
+too few radii) or implausible (``V`` at the corner outside [0.3, 1.15]) keeps ``V = 1``.
+
 Estimation (:func:`estimate_corrections`)
 -----------------------------------------
 From cells seen by several images: for every pair of images, the robust
@@ -32,6 +41,7 @@ result reports the RMS disagreement between images before and after.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -118,13 +128,23 @@ class ColorCorrection:
     offset: np.ndarray
     lab: bool
     stats: dict = field(default_factory=dict)
+    #: (n_images, 2) ``c1, c2`` of the vignetting (module docstring), or None.
+    vignetting: np.ndarray | None = None
+    #: (n_images, 2) principal point (full-resolution pixels) and (n_images,) 1 / half diagonal.
+    centre: np.ndarray | None = None
+    inv_norm: np.ndarray | None = None
 
     @classmethod
     def identity(cls, n_images: int, bands: int) -> ColorCorrection:
         return cls(np.ones((n_images, bands)), np.zeros((n_images, bands)), uses_lab(bands), {})
 
+    def has_vignetting(self, i: int) -> bool:
+        return self.vignetting is not None and bool(np.any(self.vignetting[i] != 0.0))
+
     def is_identity(self, i: int) -> bool:
-        return bool(np.all(self.gain[i] == 1.0) and np.all(self.offset[i] == 0.0))
+        return bool(
+            np.all(self.gain[i] == 1.0) and np.all(self.offset[i] == 0.0)
+        ) and not self.has_vignetting(i)
 
     def apply(self, i: int, samples: np.ndarray, dtype) -> np.ndarray:
         """Corrected samples (N, bands) of image ``i`` in the data's dtype range (float64)."""
@@ -139,15 +159,40 @@ class ColorCorrection:
             out = np.clip(out, info.min, info.max)
         return out
 
-    def apply_inplace(self, i: int, colours: np.ndarray, mask: np.ndarray, dtype) -> None:
+    def apply_inplace(self, i: int, colours: np.ndarray, mask: np.ndarray, dtype, uv=None) -> None:
         """:meth:`apply` to the samples ``colours`` (..., bands) float32 of image ``i`` where ``mask``
-        (the leading shape of ``colours``), in place, in one compiled pass."""
+        (the leading shape of ``colours``), in place, in one compiled pass; with ``uv`` (..., 2), the
+        samples' full-resolution pixel positions, the vignetting is removed first."""
         if self.is_identity(i):
             return
         if colours.dtype != np.float32 or not colours.flags.c_contiguous or mask.shape != colours.shape[:-1]:
             raise InputError("apply_inplace: colours must be C-contiguous float32 (..., bands) like the mask")
         dt = np.dtype(dtype)
         lo, hi = (float(np.iinfo(dt).min), float(np.iinfo(dt).max)) if dt.kind in "ui" else (-np.inf, np.inf)
+        if uv is not None and self.has_vignetting(i):
+            uv = np.asarray(uv)
+            if uv.shape != mask.shape + (2,):
+                raise InputError("apply_inplace: uv must be (..., 2) like the mask")
+            assert self.centre is not None and self.inv_norm is not None and self.vignetting is not None
+            _devignette(
+                colours.reshape(-1, colours.shape[-1]),
+                np.ascontiguousarray(mask).reshape(-1),
+                np.ascontiguousarray(uv, np.float64).reshape(-1, 2),
+                float(self.centre[i, 0]),
+                float(self.centre[i, 1]),
+                float(self.inv_norm[i]),
+                float(self.vignetting[i, 0]),
+                float(self.vignetting[i, 1]),
+                uses_lab(colours.shape[-1]),
+                value_scale(dt),
+                lo,
+                hi,
+                _LUTS,
+                _LUT_N,
+                _LUT_TOP,
+            )
+        if np.all(self.gain[i] == 1.0) and np.all(self.offset[i] == 0.0):
+            return
         _correct(
             colours.reshape(-1, colours.shape[-1]),
             np.ascontiguousarray(mask).reshape(-1),
@@ -175,11 +220,16 @@ class ColorCorrection:
                     "offset": [round(float(v), 5) for v in self.offset[i]],
                 }
             )
-        return {
+        out = {
             "model": "L*a*b* gain/offset" if self.lab else "per-band gain/offset",
             "images": rows,
             **self.stats,
         }
+        if self.vignetting is not None:
+            corner = np.exp(self.vignetting[:, 0] + self.vignetting[:, 1])
+            for k, row in enumerate(rows):
+                row["vignetting_at_corner"] = round(float(corner[k]), 4)
+        return out
 
 
 @njit
@@ -244,6 +294,154 @@ def _correct(c, m, gain, offset, lab, scale, lo, hi, M, M_inv, white, luts, n_lu
             start = 3
         for q in range(start, B):
             c[p, q] = min(max(np.float64(c[p, q]) * gain[q] + offset[q], lo), hi)
+
+
+@njit
+def _devignette(c, m, uv, cx, cy, inv_norm, c1, c2, rgb, scale, lo, hi, luts, n_lut, top):
+    """Samples ``c`` (n, bands) float32 where ``m``, seen at pixels ``uv`` (n, 2): divided by the
+    vignetting ``exp(c1 rho^2 + c2 rho^4)`` in linear light (sRGB decoded for the first three bands
+    when ``rgb``), clipped to ``[lo, hi]``, in place."""
+    n, B = c.shape
+    for p in range(n):
+        if not m[p]:
+            continue
+        du = (uv[p, 0] - cx) * inv_norm
+        dv = (uv[p, 1] - cy) * inv_norm
+        r2 = du * du + dv * dv
+        if not r2 == r2:
+            continue
+        g = math.exp(-(c1 * r2 + c2 * r2 * r2))
+        start = 0
+        if rgb:
+            for q in range(3):
+                lin = _lut(luts, 0, min(max(np.float64(c[p, q]) / scale, 0.0), 1.0), n_lut, top) * g
+                c[p, q] = min(max(_lut(luts, 1, min(lin, top), n_lut, top) * scale, lo), hi)
+            start = 3
+        for q in range(start, B):
+            c[p, q] = min(max(np.float64(c[p, q]) * g, lo), hi)
+
+
+def linear_luminance(values: np.ndarray, dtype) -> np.ndarray:
+    """Linear-light luminance (K,) of samples (K, bands) in the data's units: Rec. 709 weights of
+    the sRGB-decoded first three bands of RGB data, the first band (taken as linear) otherwise."""
+    v = np.asarray(values, dtype=np.float64)
+    if uses_lab(v.shape[1]):
+        x = np.clip(v[:, :3] / value_scale(dtype), 0.0, 1.0)
+        lin = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+        return lin @ np.array([0.2126, 0.7152, 0.0722])
+    return v[:, 0] / value_scale(dtype)
+
+
+def devignette_values(values: np.ndarray, factor: np.ndarray, dtype) -> np.ndarray:
+    """Samples (K, bands) divided by the vignetting ``factor`` (K,) in linear light (as
+    :func:`_devignette`), in the data's units (float64)."""
+    v = np.array(values, dtype=np.float64)
+    f = np.asarray(factor, dtype=np.float64)
+    start = 0
+    if uses_lab(v.shape[1]):
+        sc = value_scale(dtype)
+        x = np.clip(v[:, :3] / sc, 0.0, 1.0)
+        lin = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4) / f[:, None]
+        lin = np.clip(lin, 0.0, None)
+        enc = np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * lin ** (1 / 2.4) - 0.055)
+        v[:, :3] = enc * sc
+        start = 3
+    v[:, start:] /= f[:, None]
+    return v
+
+
+def estimate_vignetting(
+    obs_cell,
+    obs_image,
+    obs_lum,
+    obs_rho2,
+    image_camera,
+    max_pairs: int = 400_000,
+    seed: int = 0,
+    huber: float = 1.5,
+    iterations: int = 5,
+    lum_range: tuple[float, float] = (0.005, 0.85),
+    min_pairs: int = 500,
+    corner_range: tuple[float, float] = (0.3, 1.15),
+) -> tuple[np.ndarray, dict]:
+    """Vignetting per camera from observations of the same cells (module docstring).
+
+    Parameters
+    ----------
+    obs_cell, obs_image : (K,) int
+    obs_lum : (K,) float, linear luminance (:func:`linear_luminance`); observations outside
+        ``lum_range`` (near black, near saturation) are not used
+    obs_rho2 : (K,) float, squared distance from the principal point over the half diagonal
+    image_camera : (n_images,) int, camera index of every image
+
+    Returns
+    -------
+    (coefficients (n_images, 2): ``c1, c2`` of each image's camera, stats dict)
+    """
+    cell = np.asarray(obs_cell, dtype=np.int64).reshape(-1)
+    img = np.asarray(obs_image, dtype=np.int64).reshape(-1)
+    lum = np.asarray(obs_lum, dtype=np.float64).reshape(-1)
+    rho2 = np.asarray(obs_rho2, dtype=np.float64).reshape(-1)
+    cam_of = np.asarray(image_camera, dtype=np.int64).reshape(-1)
+    n = len(cam_of)
+    if not (len(img) == len(cell) == len(lum) == len(rho2)):
+        raise InputError("estimate_vignetting: observation arrays differ in length")
+    if len(img) and (img.min() < 0 or img.max() >= n):
+        raise InputError("estimate_vignetting: image index out of range")
+    n_cam = int(cam_of.max()) + 1 if n else 0
+    coef = np.zeros((n, 2))
+    stats: dict = {"cameras": {}}
+    ok = np.isfinite(lum) & np.isfinite(rho2) & (lum > lum_range[0]) & (lum < lum_range[1])
+    idx = np.flatnonzero(ok)
+    ii, jj = _pairs(cell[idx], max_pairs, seed)
+    ii, jj = idx[ii], idx[jj]
+    keep = img[ii] != img[jj]
+    ii, jj = ii[keep], jj[keep]
+    stats["pairs"] = int(len(ii))
+    if len(ii) < min_pairs or n_cam == 0:
+        return coef, stats
+    ia, ib = img[ii], img[jj]
+    d = np.log(lum[ii]) - np.log(lum[jj])
+    # unknowns: u (n images), then c1, c2 per camera
+    import scipy.sparse as sp
+
+    nu = n + 2 * n_cam
+    m = len(ii)
+    ca, cb = cam_of[ia], cam_of[ib]
+    # six entries per pair (sparse: the normal matrix is only images + 2 cameras square)
+    cols = np.column_stack([ia, ib, n + 2 * ca, n + 2 * ca + 1, n + 2 * cb, n + 2 * cb + 1])
+    vals = np.column_stack([np.ones(m), -np.ones(m), rho2[ii], rho2[ii] ** 2, -rho2[jj], -(rho2[jj] ** 2)])
+    A = sp.csr_matrix((vals.ravel(), (np.repeat(np.arange(m), 6), cols.ravel())), shape=(m, nu))
+    w = np.ones(m)
+    ridge = np.full(nu, 1e-6 * m)
+    ridge[:n] = 1e-3  # u: only their sum is fixed, by this pull to 0
+    x = np.zeros(nu)
+    r = d
+    for _ in range(int(iterations)):
+        N = (A.T @ A.multiply(w[:, None])).toarray() + np.diag(ridge)
+        x = np.linalg.solve(N, A.T @ (w * d))
+        r = d - A @ x
+        s = 1.4826 * np.median(np.abs(r)) + 1e-12
+        t = huber * s
+        w = np.where(np.abs(r) <= t, 1.0, t / np.maximum(np.abs(r), 1e-300))
+    # precision of each camera's corner value from the weighted normal matrix
+    N = (A.T @ A.multiply(w[:, None])).toarray() + np.diag(ridge)
+    cov = np.linalg.inv(N) * (float(np.sum(w * r * r)) / max(len(r) - nu, 1))
+    for c in range(n_cam):
+        c1, c2 = float(x[n + 2 * c]), float(x[n + 2 * c + 1])
+        e = np.zeros(nu)
+        e[n + 2 * c] = e[n + 2 * c + 1] = 1.0
+        sd = float(np.sqrt(max(e @ cov @ e, 0.0)))
+        corner = math.exp(c1 + c2)
+        used = bool(corner_range[0] <= corner <= corner_range[1] and sd < 0.05 and np.any(cam_of[ia] == c))
+        stats["cameras"][c] = {
+            "corner_factor": round(corner, 4),
+            "corner_sd": round(sd, 4),
+            "used": used,
+        }
+        if used:
+            coef[cam_of == c] = (c1, c2)
+    return coef, stats
 
 
 def estimate_corrections(

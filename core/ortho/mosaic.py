@@ -285,7 +285,7 @@ def _sample_candidates(views, store, res, needed, workers, out, lum_weights, fil
             out[k],
         )
         if correction is not None:
-            correction.apply_inplace(i, out[k], m, store.dtype)
+            correction.apply_inplace(i, out[k], m, store.dtype, uvk)
 
     each(one, range(K), workers)
 

@@ -46,7 +46,14 @@ from ..orientation import Orientation, as_orientation
 from ..parallel import Digest, InProcessExecutor, file_identity, make_executor, tile_run
 from ..progress import Progress, Steps, SubProgress, as_progress, check
 from ..rasterio_io import COMPRESSIONS
-from .color import ColorCorrection, estimate_corrections, to_channels
+from .color import (
+    ColorCorrection,
+    devignette_values,
+    estimate_corrections,
+    estimate_vignetting,
+    linear_luminance,
+    to_channels,
+)
 from .mosaic import ImageStore, MosaicParams, candidate_colours, each
 from .seams import dissolve, region_polygons
 from .surface import PlanTransform, open_surface, same_crs, transform_bounds
@@ -81,6 +88,9 @@ class TrueOrthoConfig:
         Output CRS; default the orientation's.
     color_correction : bool
         Estimate and apply per-image corrections (:mod:`.color`).
+    vignetting : bool
+        With the colour correction, a radial vignetting per camera is estimated from the
+        overlaps and removed first (:func:`~.color.estimate_vignetting`).
     max_view_angle : float
         Largest off-nadir angle (degrees) of a viewing ray that may texture a cell.
     blend_width : int
@@ -158,6 +168,9 @@ class TrueOrthoConfig:
     extent: tuple[float, float, float, float] | None = None
     crs: str | None = None
     color_correction: bool = True
+    #: With the colour correction, estimate and remove a radial vignetting per camera
+    #: (:func:`~.color.estimate_vignetting`).
+    vignetting: bool = True
     max_view_angle: float = 45.0
     blend_width: int = 5
     visibility: bool = True
@@ -731,7 +744,7 @@ def run_mosaic(
         t0 = time.perf_counter()
         if cfg.color_correction and len(cand.relevant) > 1:
             correction = _estimate_colour(
-                setup, surf, grid, to_local, store, cfg, steps[1], workers, len(o.images)
+                setup, surf, grid, to_local, store, cfg, steps[1], workers, len(o.images), _optics(o)
             )
             stats["color_correction"] = correction.as_dict([im.name for im in o.images])
         ctx.correction = correction
@@ -935,7 +948,19 @@ def _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs) -> str
     d.add({k: v for k, v in dataclasses.asdict(cfg).items() if k not in _NOT_IN_KEY})
     if correction is not None:
         d.add([np.asarray(correction.gain), np.asarray(correction.offset), bool(correction.lab)])
+        if correction.vignetting is not None:
+            d.add([np.asarray(correction.vignetting), np.asarray(correction.centre)])
     return d.hexdigest()
+
+
+def _optics(o) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per image: camera index, principal point (full-resolution pixels) and 1 / half diagonal."""
+    ids = {cid: k for k, cid in enumerate(sorted(o.cameras))}
+    cams = [o.cameras[im.camera] for im in o.images]
+    image_camera = np.array([ids[im.camera] for im in o.images], dtype=np.int64)
+    centre = np.array([[c.cx, c.cy] for c in cams], dtype=np.float64).reshape(-1, 2)
+    inv_norm = np.array([2.0 / math.hypot(c.width, c.height) for c in cams], dtype=np.float64)
+    return image_camera, centre, inv_norm
 
 
 def _estimate_colour(
@@ -948,8 +973,11 @@ def _estimate_colour(
     progress,
     workers: int,
     n_images: int,
+    optics: tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> ColorCorrection:
-    """Corrections from a decimated copy of the output grid (cells seen cleanly by >= 2 images)."""
+    """Corrections from a decimated copy of the output grid (cells seen cleanly by >= 2 images):
+    the vignetting per camera first (with ``cfg.vignetting``), then gains and offsets on the
+    samples it corrected."""
     f = max(1, int(math.ceil(math.sqrt(grid.rows * grid.cols / max(cfg.color_cells, 1000)))))
     g = grid.scaled(f)
     # the depth margin is in cells of the grid used
@@ -959,7 +987,7 @@ def _estimate_colour(
         setup, margin_cells=int(math.ceil(setup.margin_cells / f)) + 1, views_per_cell=0, top_views=0
     )
     tiles = g.tiles(cfg.tile_size, 0)
-    cells, imgs, vals = [], [], []
+    cells, imgs, vals, uvs = [], [], [], []
     for n, tile in enumerate(tiles):
         check(progress)
         views = tile_views(st, surf, g, tile, to_local, workers)
@@ -980,12 +1008,28 @@ def _estimate_colour(
                 cells.append(cid[mk][good])
                 imgs.append(np.full(int(good.sum()), int(views.cands[k])))
                 vals.append(v[good])
+                uvs.append(np.asarray(views.uv[k][rr[mk], cc[mk]], np.float64)[good])
         progress.update((n + 1) / len(tiles), f"colour statistics {n + 1}/{len(tiles)}")
     if not cells:
         return ColorCorrection.identity(n_images, store.bands)
-    values = to_channels(np.concatenate(vals), store.dtype)
-    corr = estimate_corrections(np.concatenate(cells), np.concatenate(imgs), values, n_images)
+    cell, img, raw = np.concatenate(cells), np.concatenate(imgs), np.concatenate(vals)
+    vig = None
+    image_camera, centre, inv_norm = optics
+    if cfg.vignetting:
+        d = (np.concatenate(uvs) - centre[img]) * inv_norm[img][:, None]
+        rho2 = (d**2).sum(axis=1)
+        vig, vstats = estimate_vignetting(cell, img, linear_luminance(raw, store.dtype), rho2, image_camera)
+        if np.any(vig != 0.0):
+            factor = np.exp(vig[img, 0] * rho2 + vig[img, 1] * rho2**2)
+            raw = devignette_values(raw, factor, store.dtype)
+        else:
+            vig = None
+    corr = estimate_corrections(cell, img, to_channels(raw, store.dtype), n_images)
     corr.stats["grid_factor"] = f
+    if cfg.vignetting:
+        corr.stats["vignetting"] = vstats
+    if vig is not None:
+        corr.vignetting, corr.centre, corr.inv_norm = vig, centre, inv_norm
     return corr
 
 

@@ -7,9 +7,12 @@ import pytest
 
 from truortho.core.ortho.color import (
     ColorCorrection,
+    devignette_values,
     estimate_corrections,
+    estimate_vignetting,
     from_channels,
     lab_to_rgb,
+    linear_luminance,
     rgb_to_lab,
     to_channels,
 )
@@ -183,3 +186,70 @@ def test_a_long_strip_of_images_keeps_every_image_pair():
         cells, imgs, vals, n_img, per_pair=0, budget=0, max_pairs=corr.stats["pairs_used"]
     )
     assert np.abs(glob.gain[:, 0] - g_true).max() > 1.2 * err
+
+
+def _vignetted_block(corner, seed=0, n_images=12, n_cells=6000, views=4):
+    """Observations of cells seen by several images of one camera: linear albedo x exposure x
+    vignetting ``exp(c rho^2)`` with ``exp(c) = corner``, sRGB-encoded to uint8 range."""
+    rng = np.random.default_rng(seed)
+    c = np.log(corner)
+    albedo = rng.uniform(0.05, 0.6, (n_cells, 3))
+    exposure = rng.uniform(0.8, 1.2, n_images)
+    cells, imgs, rho2s, vals = [], [], [], []
+    for cell in range(n_cells):
+        for i in rng.choice(n_images, views, replace=False):
+            rho2 = rng.uniform(0.0, 1.0)
+            lin = np.clip(albedo[cell] * exposure[i] * np.exp(c * rho2), 0, 1)
+            enc = np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * lin ** (1 / 2.4) - 0.055)
+            cells.append(cell)
+            imgs.append(i)
+            rho2s.append(rho2)
+            vals.append(enc * 255.0 + rng.normal(0, 0.5, 3))
+    return np.array(cells), np.array(imgs), np.array(rho2s), np.array(vals), n_images
+
+
+@pytest.mark.parametrize("corner", [0.45, 0.75, 1.0])
+def test_vignetting_is_recovered_from_overlaps(corner):
+    cells, imgs, rho2, vals, n = _vignetted_block(corner)
+    lum = linear_luminance(vals, np.uint8)
+    coef, stats = estimate_vignetting(cells, imgs, lum, rho2, np.zeros(n, int))
+    est = float(np.exp(coef[0].sum()))
+    if corner == 1.0:
+        # nothing to remove: a corner factor within 2 % of 1 (or not used at all)
+        assert abs(est - 1.0) < 0.02, stats
+    else:
+        assert stats["cameras"][0]["used"], stats
+        assert abs(est - corner) < 0.02, (est, stats)
+        # removed, the log luminance about each cell's mean no longer falls with the radius
+        f = np.exp(coef[imgs, 0] * rho2 + coef[imgs, 1] * rho2**2)
+        fixed = linear_luminance(devignette_values(vals, f, np.uint8), np.uint8)
+
+        def slope(y):
+            d = np.log(y) - np.bincount(cells, np.log(y))[cells] / np.bincount(cells)[cells]
+            r = rho2 - np.bincount(cells, rho2)[cells] / np.bincount(cells)[cells]
+            return float((d @ r) / (r @ r))
+
+        assert slope(lum) < 0.8 * np.log(corner)
+        assert abs(slope(fixed)) < 0.02
+
+
+def test_vignetting_needs_overlap_and_apply_inplace_removes_it():
+    # too little overlap (fewer observation pairs than min_pairs): nothing estimated
+    cells, imgs, rho2, vals, n = _vignetted_block(0.6, n_cells=40)
+    coef, stats = estimate_vignetting(cells, imgs, linear_luminance(vals, np.uint8), rho2, np.zeros(n, int))
+    assert stats["pairs"] < 500 and np.all(coef == 0.0) and not stats["cameras"], stats
+    # apply_inplace with the pixel positions: a corner sample is brightened by 1 / corner (linear light)
+    c = np.log(0.6)
+    corr = ColorCorrection.identity(1, 3)
+    corr.vignetting = np.array([[c, 0.0]])
+    corr.centre, corr.inv_norm = np.array([[50.0, 40.0]]), np.array([1.0 / 64.0])
+    grey = 0.3 * 0.6  # linear value at the corner
+    enc = 1.055 * grey ** (1 / 2.4) - 0.055
+    colours = np.full((1, 2, 3), enc * 255.0, np.float32)
+    uv = np.array([[[50.0 + 64.0, 40.0], [50.0, 40.0]]])  # rho = 1, then the centre
+    corr.apply_inplace(0, colours, np.ones((1, 2), bool), np.uint8, uv)
+    back = ((colours[0, 0, 0] / 255.0 + 0.055) / 1.055) ** 2.4
+    assert back == pytest.approx(0.3, rel=2e-3)
+    assert colours[0, 1, 0] == pytest.approx(enc * 255.0, abs=0.05)  # at the principal point: unchanged
+    with pytest.raises(Exception, match="uv"):
+        corr.apply_inplace(0, colours, np.ones((1, 2), bool), np.uint8, uv[:, :1])
