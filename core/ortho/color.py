@@ -211,7 +211,7 @@ class ColorCorrection:
         )
 
     def as_dict(self, names: list[str] | None = None) -> dict:
-        rows = []
+        rows: list[dict] = []
         for i in range(len(self.gain)):
             rows.append(
                 {
@@ -431,7 +431,7 @@ def estimate_vignetting(
         c1, c2 = float(x[n + 2 * c]), float(x[n + 2 * c + 1])
         e = np.zeros(nu)
         e[n + 2 * c] = e[n + 2 * c + 1] = 1.0
-        sd = float(np.sqrt(max(e @ cov @ e, 0.0)))
+        sd = math.sqrt(max(float(e @ cov @ e), 0.0))
         corner = math.exp(c1 + c2)
         used = bool(corner_range[0] <= corner <= corner_range[1] and sd < 0.05 and np.any(cam_of[ia] == c))
         stats["cameras"][c] = {

@@ -862,6 +862,7 @@ def _resume(st: _State, start: Reconstruction, cfg: IncrementalConfig) -> tuple[
         start.obs_track is not None
         and len(start.obs_track) == len(st.track)
         and np.array_equal(start.obs_track, st.track)
+        and start.obs_image is not None
         and np.array_equal(start.obs_image, st.image)
     )
     n_reg = int(st.reg.sum())
