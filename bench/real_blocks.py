@@ -4,7 +4,7 @@ Not a test. Run from the repository root::
 
     make acceptance-real                      # the bundled sample (make demo's block)
     source scripts/env.sh && python -P bench/real_blocks.py --blocks sample,brighton,boruszyn,copr \
-        [--resolution 0] [--keep DIR] [--write-docs]
+        [--resolution 0 | --resolution sample=0.25,copr=0.05] [--keep DIR] [--write-docs]
 
 Each block runs as a user would run it: ``truortho:importgcps`` (where the block has an ODM
 ``gcp_list.txt``), then ``truortho:pipeline`` through ``qgis_process`` with its defaults (the
@@ -20,8 +20,8 @@ check points named below stay out of the adjustment). On the products (:func:`me
   on natural terrain;
 * **empty share** of the true ortho's frame (the cells with no colour) and its isolated empty
   cells (no colour, all 8 neighbours coloured: speckle), and the cells flagged in OCCLUSION;
-* the wall time of the pipeline, and a picture per block (hillshade beside the ortho) in
-  ``bench/results/real/``.
+* the wall time and the peak resident memory of the pipeline's process, and a picture per block
+  (hillshade beside the ortho) in ``bench/results/real/``.
 """
 
 from __future__ import annotations
@@ -58,17 +58,39 @@ BLOCKS = {
 }
 
 
-def qgis_pipeline(args: list[str], folder: str, label: str) -> float:
+def qgis_pipeline(args: list[str], folder: str, label: str) -> tuple[float, float]:
     """``truortho:pipeline`` through ``qgis_process`` with ``args``; its output goes to
-    ``folder/pipeline.log``. Returns the wall time, seconds; a failure ends the bench."""
+    ``folder/pipeline.log``. Returns the wall time (s) and the peak resident memory of the process
+    tree (MB; NaN where ``os.wait4`` is missing); a failure ends the bench."""
+    log = os.path.join(folder, "pipeline.log")
     t = time.perf_counter()
-    p = subprocess.run([QP, "run", "truortho:pipeline", "--", *args], capture_output=True, text=True)
+    with open(log, "w") as fh:
+        cmd = [QP, "run", "truortho:pipeline", "--", *args]
+        p = subprocess.Popen(cmd, stdout=fh, stderr=subprocess.STDOUT)
+        if hasattr(os, "wait4"):
+            _, status, usage = os.wait4(p.pid, 0)
+            p.returncode = os.waitstatus_to_exitcode(status)
+            peak = usage.ru_maxrss / 1024.0  # Linux: kB
+        else:  # pragma: no cover - Windows
+            p.wait()
+            peak = math.nan
     seconds = time.perf_counter() - t
-    with open(os.path.join(folder, "pipeline.log"), "w") as fh:
-        fh.write(p.stdout + p.stderr)
     if p.returncode:
-        raise SystemExit(f"{label}: the pipeline failed (see {folder}/pipeline.log):\n{p.stderr[-2000:]}")
-    return seconds
+        with open(log) as fh:
+            tail = fh.read()[-2000:]
+        raise SystemExit(f"{label}: the pipeline failed (see {log}):\n{tail}")
+    return seconds, peak
+
+
+def resolution_of(spec: str, block: str) -> float:
+    """The RESOLUTION of ``block`` from ``--resolution`` (a number, or ``name=value,...``)."""
+    if "=" not in spec:
+        return float(spec)
+    for part in spec.split(","):
+        name, _, value = part.partition("=")
+        if name.strip() == block:
+            return float(value)
+    return 0.0
 
 
 def run_block(name: str, out: str, resolution: float, log) -> dict:
@@ -83,9 +105,9 @@ def run_block(name: str, out: str, resolution: float, log) -> dict:
         subprocess.run(imp, check=True, capture_output=True)
         args += [f"GCPS={out}/gcps.gpkg", f"OBSERVATIONS={out}/obs.gpkg"]
     log(f"{name}: truortho:pipeline on {len(os.listdir(images))} photos")
-    seconds = qgis_pipeline(args, out, name)
+    seconds, peak = qgis_pipeline(args, out, name)
     m = measures(os.path.join(out, "products"))
-    m.update(block=name, seconds=seconds)
+    m.update(block=name, seconds=seconds, peak_mb=peak)
     picture(os.path.join(out, "products"), os.path.join(HERE, "results", "real", f"{name}.jpg"))
     log(f"  {json.dumps(m)}")
     return m
@@ -189,7 +211,8 @@ def picture(products: str, path: str) -> None:
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--blocks", default="sample", help=f"comma-separated, of {', '.join(BLOCKS)}")
-    ap.add_argument("--resolution", type=float, default=0.0, help="RESOLUTION of the pipeline (0 = the GSD)")
+    ap.add_argument("--resolution", default="0", help="RESOLUTION of the pipeline (0 = the GSD): one value "
+                    "for every block, or per block as name=value,... (the others 0)")  # fmt: skip
     ap.add_argument("--keep", default="", help="keep the products in this folder")
     ap.add_argument("--write-docs", action="store_true", help=f"update the marked section of {DOCS}")
     args = ap.parse_args(argv)
@@ -199,7 +222,8 @@ def main(argv=None) -> int:
             raise SystemExit(f"--blocks: unknown block {b!r} (expected {', '.join(BLOCKS)})")
     work = args.keep or tempfile.mkdtemp(prefix="truortho-real-")
     rows = [
-        run_block(b, os.path.join(work, b), args.resolution, lambda m: print(m, flush=True)) for b in names
+        run_block(b, os.path.join(work, b), resolution_of(args.resolution, b), lambda m: print(m, flush=True))
+        for b in names
     ]
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()  # fmt: skip
@@ -208,8 +232,8 @@ def main(argv=None) -> int:
         f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {os.cpu_count()} cores",
         "",
         "| block | cells (res m) | area seen by >= 2 photos m^2 | completeness | raw holes | holes >= 1 m^2 "
-        "| roughness m | streak index | ortho empty (frame / seen by 2) | speckle | occluded | s |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| roughness m | streak index | ortho empty (frame / seen by 2) | speckle | occluded | s | peak MB |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
@@ -217,7 +241,7 @@ def main(argv=None) -> int:
             f"{100 * r['completeness']:.1f} % | {100 * r['raw_holes']:.1f} % | {r['holes_over_1m2']} | "
             f"{r['roughness_m']:.3f} | {r['streak_index']:.2f} | {100 * r['ortho_empty']:.1f} / "
             f"{100 * r['ortho_empty_seen2']:.1f} % | {r['ortho_speckle']} | {r['occlusion_flagged']} | "
-            f"{r['seconds']:.0f} |"
+            f"{r['seconds']:.0f} | {r.get('peak_mb', math.nan):.0f} |"
         )
     text = "\n".join(lines)
     print("\n" + text)
