@@ -509,6 +509,17 @@ def scene_table(rows: list[dict]) -> list[str]:
     return lines
 
 
+def run_header(script: str, argv, detail: str = "") -> tuple[str, str, str]:
+    """``(command, commit, head)`` of a run of ``bench/<script>``: the head line of its docs section
+    (command, commit, date, machine, ``detail``)."""
+    cmd = f"python -P bench/{script} " + " ".join(argv if argv is not None else sys.argv[1:])
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                            text=True).stdout.strip()  # fmt: skip
+    head = (f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {platform.machine()} "
+            f"{os.cpu_count()} cores" + (f", {detail}" if detail else ""))  # fmt: skip
+    return cmd, commit, head
+
+
 def write_docs(text: str, section: str = "acceptance") -> None:
     """Replace the marked ``section`` of docs/acceptance.md with ``text``."""
     begin, end = f"<!-- {section}:begin -->", f"<!-- {section}:end -->"
@@ -561,14 +572,10 @@ def main(argv=None) -> int:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
     wall = time.perf_counter() - t0
-    cmd = "python -P bench/acceptance.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()  # fmt: skip
     import cv2
 
-    head = (f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {platform.machine()} "
-            f"{os.cpu_count()} cores, OpenCV {cv2.__version__}; {len(rows)} scenes, master seed {args.seed}, "
-            f"{wall / 60:.1f} min")  # fmt: skip
+    cmd, commit, head = run_header("acceptance.py", argv, f"OpenCV {cv2.__version__}")
+    head += f"; {len(rows)} scenes, master seed {args.seed}, {wall / 60:.1f} min"
     text = "\n".join([head, "", *summary(rows), "", *scene_table(rows), ""])
     print("\n" + text)
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)

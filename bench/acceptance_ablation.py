@@ -27,11 +27,8 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import datetime
 import os
-import platform
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -49,8 +46,10 @@ VARIANTS = (
     ("as drawn", {}),
     ("no JPEG", {"jpeg_quality": 0}),
     ("no noise, no JPEG", {"jpeg_quality": 0, "noise_sigma": 0.0}),
-    ("clean", {"jpeg_quality": 0, "noise_sigma": 0.0, "gain_sigma": 0.0, "offset_sigma": 0.0,
-               "vignetting": 0.0}),
+    (
+        "clean",
+        {"jpeg_quality": 0, "noise_sigma": 0.0, "gain_sigma": 0.0, "offset_sigma": 0.0, "vignetting": 0.0},
+    ),
 )
 FIGURES = ("ghosting", "ghosting_beyond_outline", "mean_dE", "relative_dE")
 
@@ -140,12 +139,8 @@ def main(argv=None) -> int:
         rows = [run_scene(i, args.seed, work, lambda m: print(m, flush=True)) for i in indices]
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    cmd = "python -P bench/acceptance_ablation.py " + " ".join(argv if argv is not None else sys.argv[1:])
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()  # fmt: skip
-    head = (f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {platform.machine()} "
-            f"{os.cpu_count()} cores; {len(rows)} scenes, master seed {args.seed}, "
-            f"{(time.perf_counter() - t0) / 60:.1f} min")  # fmt: skip
+    _, _, head = acceptance.run_header("acceptance_ablation.py", argv)
+    head += f"; {len(rows)} scenes, master seed {args.seed}, {(time.perf_counter() - t0) / 60:.1f} min"
     text = "\n".join([head, "", *tables(rows), ""])
     print("\n" + text)
     if args.write_docs:

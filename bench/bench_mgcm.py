@@ -15,9 +15,8 @@ in the same run on the same images:
   independent LSM per view;
 * ArUco markers: detection rate and centre accuracy, LSM-refined centre against the diagonal
   intersection of OpenCV's sub-pixel corners;
-* with ``--orientation`` (not by default): ``orient_images`` on one synthetic nadir+oblique block
-  with and without LSM refinement of the tie points (sigma0, check RMSE); bench_tiepoints.py
-  (``make bench BENCH=tiepoints``) compares them on several blocks and copr, camera errors included.
+* the tie points refined by LSM inside ``orient_images``: ``make bench BENCH=tiepoints``
+  (bench_tiepoints.py: several blocks and copr, camera errors against the truth).
 
 The goal of issue 19: refined target positions within 0.1 px RMS from starts up to 3 px off.
 """
@@ -279,48 +278,6 @@ def bench_aruco(scenes: int) -> None:
     )
 
 
-def bench_orientation(seed: int) -> None:
-    """Tie points refined by LSM inside orient_images against the unrefined run, same block."""
-    import tempfile
-    from pathlib import Path
-
-    from truortho.core.formats.gcplist import read_gcp_list
-    from truortho.core.sfm.pipeline import OrientConfig, orient_images
-    from truortho.core.synthetic import SceneConfig, make_scene
-
-    cfg = SceneConfig(
-        n_oblique=8, n_gcps=14, min_gcp_views=4, check_fraction=0.4, gcp_pixel_sigma=0.5, seed=seed
-    )
-    scene = make_scene(cfg)
-    with tempfile.TemporaryDirectory() as tmp:
-        folder = Path(tmp)
-        scene.write(folder)
-        crs, gcps = read_gcp_list(folder / "gcp_list.txt")
-        roles = {g.name: g.role for g in scene.orientation.gcps}
-        for g in gcps:
-            g.role = roles[g.name]
-        paths = sorted(str(p) for p in folder.glob("img_*.png"))
-        print(
-            f"\norientation of the synthetic nadir+oblique block (seed {seed}, "
-            f"GSD {cfg.flying_height / cfg.focal_px:.3f} m)"
-        )
-        for refine in (False, True):
-            t0 = time.perf_counter()
-            run = orient_images(
-                paths,
-                gcps=gcps,
-                crs=crs,
-                config=OrientConfig(working_size=640, refine_tie_points=refine),
-                work_dir=folder / "work",
-            )
-            rep = run.report.data
-            c = rep["check_rmse"]
-            print(
-                f"  tie refinement {'on ' if refine else 'off'}: sigma0 {rep['bundle']['sigma0']:.3f} px, "
-                f"check RMSE xy {c['xy']:.4f} z {c['z']:.4f} m, {time.perf_counter() - t0:.0f} s"
-            )
-
-
 def _subpix():
     p = cv2.aruco.DetectorParameters()
     p.cornerRefinementMethod = cv2.aruco.CORNER_REFINE_SUBPIX
@@ -332,11 +289,6 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=12, help="images per start offset")
     ap.add_argument("--blocks", type=int, default=3)
     ap.add_argument("--aruco", type=int, default=12, help="ArUco scenes")
-    ap.add_argument(
-        "--orientation",
-        action="store_true",
-        help="also orient a synthetic block with and without tie-point refinement",
-    )
     a = ap.parse_args()
     t0 = time.perf_counter()
     bench_targets("disc", a.seeds)
@@ -344,8 +296,6 @@ def main() -> None:
     bench_texture(a.seeds)
     bench_mgcm(a.blocks, 3)
     bench_aruco(a.aruco)
-    if a.orientation:
-        bench_orientation(3)
     print(f"\ntotal {time.perf_counter() - t0:.0f} s")
 
 

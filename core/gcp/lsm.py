@@ -518,8 +518,9 @@ def _lm_stage(t, window, gx, gy, pc, r, idx, n_shape, max_iter, tol, max_shift, 
 
 
 @njit
-def _ncc_k(a, b):
-    """:func:`_ncc` in a kernel: normalised cross-correlation over the finite values of ``b``."""
+def _masked_moments(a, b):
+    """Count, means and centred sums of squares and products of ``a`` and ``b`` over the finite
+    values of ``b``: ``(n, mean_a, mean_b, saa, sbb, sab)`` (means 0 when ``n`` is 0)."""
     cnt = 0
     sa = 0.0
     sb = 0.0
@@ -529,21 +530,30 @@ def _ncc_k(a, b):
                 cnt += 1
                 sa += a[i, j]
                 sb += b[i, j]
-    if cnt < 3:
-        return np.nan
+    if cnt == 0:
+        return 0, 0.0, 0.0, 0.0, 0.0, 0.0
     ma = sa / cnt
     mb = sb / cnt
-    sxx = 0.0
-    syy = 0.0
-    sxy = 0.0
+    saa = 0.0
+    sbb = 0.0
+    sab = 0.0
     for i in range(a.shape[0]):
         for j in range(a.shape[1]):
             if np.isfinite(b[i, j]):
                 x = a[i, j] - ma
                 y = b[i, j] - mb
-                sxx += x * x
-                syy += y * y
-                sxy += x * y
+                saa += x * x
+                sbb += y * y
+                sab += x * y
+    return cnt, ma, mb, saa, sbb, sab
+
+
+@njit
+def _ncc_k(a, b):
+    """:func:`_ncc` in a kernel: normalised cross-correlation over the finite values of ``b``."""
+    cnt, _, _, sxx, syy, sxy = _masked_moments(a, b)
+    if cnt < 3:
+        return np.nan
     d = math.sqrt(sxx * syy)
     return sxy / d if d > 0 else 0.0
 
@@ -551,26 +561,9 @@ def _ncc_k(a, b):
 @njit
 def _radiometric_start(t, probe, r):
     """Gain and offset matching the means and spreads of ``t`` and the finite ``probe`` values."""
-    cnt = 0
-    st = 0.0
-    sp = 0.0
-    for i in range(t.shape[0]):
-        for j in range(t.shape[1]):
-            if np.isfinite(probe[i, j]):
-                cnt += 1
-                st += t[i, j]
-                sp += probe[i, j]
+    cnt, mt, mp, vt, vp, _ = _masked_moments(t, probe)
     if cnt <= 3:
         return
-    mt = st / cnt
-    mp = sp / cnt
-    vt = 0.0
-    vp = 0.0
-    for i in range(t.shape[0]):
-        for j in range(t.shape[1]):
-            if np.isfinite(probe[i, j]):
-                vt += (t[i, j] - mt) ** 2
-                vp += (probe[i, j] - mp) ** 2
     if vp > 0:
         r1 = math.sqrt(vt / cnt) / math.sqrt(vp / cnt)
         r[0] = mt - r1 * mp
