@@ -48,6 +48,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     RESOLUTION = "RESOLUTION"
     CRS = "CRS"
     COLOR_CORRECTION = "COLOR_CORRECTION"
+    VIGNETTING = "VIGNETTING"
     MAX_VIEW_ANGLE = "MAX_VIEW_ANGLE"
     BLEND_WIDTH = "BLEND_WIDTH"
     TILE_SIZE = "TILE_SIZE"
@@ -63,6 +64,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     CONFIG_DEFAULTS = {
         RESOLUTION: FromConfig("ortho.pipeline.TrueOrthoConfig", "resolution", none=0.0),
         COLOR_CORRECTION: FromConfig("ortho.pipeline.TrueOrthoConfig", "color_correction"),
+        VIGNETTING: FromConfig("ortho.pipeline.TrueOrthoConfig", "vignetting"),
         MAX_VIEW_ANGLE: FromConfig("ortho.pipeline.TrueOrthoConfig", "max_view_angle"),
         BLEND_WIDTH: FromConfig("ortho.pipeline.TrueOrthoConfig", "blend_width"),
         TILE_SIZE: FromConfig("ortho.pipeline.TrueOrthoConfig", "tile_size"),
@@ -103,6 +105,13 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
         self.add(
             QgsProcessingParameterBoolean(
                 self.COLOR_CORRECTION, tr("Colour correction"), self.default(self.COLOR_CORRECTION)
+            )
+        )
+        self.add(
+            QgsProcessingParameterBoolean(
+                self.VIGNETTING,
+                tr("Remove vignetting (with the colour correction)"),
+                self.default(self.VIGNETTING),
             )
         )
         self.add(
@@ -206,6 +215,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             extent=extent,
             crs=out_crs,
             color_correction=self.parameterAsBool(parameters, self.COLOR_CORRECTION, context),
+            vignetting=self.parameterAsBool(parameters, self.VIGNETTING, context),
             max_view_angle=self.parameterAsDouble(parameters, self.MAX_VIEW_ANGLE, context),
             blend_width=self.parameterAsInt(parameters, self.BLEND_WIDTH, context),
             tile_size=self.parameterAsInt(parameters, self.TILE_SIZE, context),

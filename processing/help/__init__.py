@@ -295,6 +295,9 @@ HELP: dict[str, dict] = {
             "output grid and cell centres are transformed to the orientation's CRS (images are resampled "
             "once).",
             "COLOR_CORRECTION": "Estimate and apply per-image colour corrections before mosaicking.",
+            "VIGNETTING": "With the colour correction: estimate a radial darkening towards the image corners "
+            "per camera from the overlaps and remove it first. Images without vignetting get a factor of "
+            "about 1; switch it off for images already corrected in processing.",
             "MAX_VIEW_ANGLE": "Largest off-nadir angle of the viewing ray (degrees) for an image to texture "
             "a cell; also bounds how far outside a tile occluders are searched.",
             "BLEND_WIDTH": "Width of the feathering across seamlines, in cells (0 = hard seams).",
