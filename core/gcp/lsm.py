@@ -284,17 +284,24 @@ def _image(a, what: str) -> np.ndarray:
     return arr
 
 
-def _crop(image: np.ndarray, cx: float, cy: float, radius: float):
-    """Window of ``image`` around (cx, cy) of the given radius: (window, x offset, y offset).
-
-    Raises InputError when the window holds NaN or infinite values.
-    """
-    h, w = image.shape
+@njit
+def _window_bounds(h, w, cx, cy, radius):
+    """Pixel bounds ``(x0, y0, x1, y1)`` (end exclusive, clipped to an ``h`` x ``w`` image) of the
+    window around (cx, cy) that :func:`_crop` and :func:`_window` cut: ``radius`` + 2 pixels."""
     r = int(math.ceil(radius)) + 2
     x0 = max(0, int(math.floor(cx)) - r)
     y0 = max(0, int(math.floor(cy)) - r)
     x1 = min(w, int(math.floor(cx)) + r + 2)
     y1 = min(h, int(math.floor(cy)) + r + 2)
+    return x0, y0, x1, y1
+
+
+def _crop(image: np.ndarray, cx: float, cy: float, radius: float):
+    """Window of ``image`` around (cx, cy) of the given radius: (window, x offset, y offset).
+
+    Raises InputError when the window holds NaN or infinite values.
+    """
+    x0, y0, x1, y1 = _window_bounds(image.shape[0], image.shape[1], float(cx), float(cy), float(radius))
     if x1 - x0 < 3 or y1 - y0 < 3:
         return None, x0, y0
     win = np.ascontiguousarray(image[y0:y1, x0:x1], dtype=np.float64)
@@ -573,12 +580,7 @@ def _radiometric_start(t, probe, r):
 @njit
 def _window(image, cx, cy, radius):
     """:func:`_crop` in a kernel: (float64 window or an empty one, x offset, y offset, all finite)."""
-    h, w = image.shape
-    rr = int(math.ceil(radius)) + 2
-    x0 = max(0, int(math.floor(cx)) - rr)
-    y0 = max(0, int(math.floor(cy)) - rr)
-    x1 = min(w, int(math.floor(cx)) + rr + 2)
-    y1 = min(h, int(math.floor(cy)) + rr + 2)
+    x0, y0, x1, y1 = _window_bounds(image.shape[0], image.shape[1], cx, cy, radius)
     if x1 - x0 < 3 or y1 - y0 < 3:
         return np.empty((0, 0)), x0, y0, True
     win = np.empty((y1 - y0, x1 - x0))
