@@ -58,10 +58,19 @@ _WHITE = np.array([0.95047, 1.0, 1.08883])
 _D = 6.0 / 29.0
 
 
+def _srgb_decode(c: np.ndarray) -> np.ndarray:
+    """Linear light of sRGB-encoded values in [0, 1] (the sRGB transfer function's inverse)."""
+    return np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+
+
+def _srgb_encode(lin: np.ndarray) -> np.ndarray:
+    """sRGB-encoded values of linear light (non-negative)."""
+    return np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * lin ** (1 / 2.4) - 0.055)
+
+
 def rgb_to_lab(rgb) -> np.ndarray:
     """CIE L*a*b* (D65) of sRGB colours in [0, 1], (..., 3) -> (..., 3) float64."""
-    c = np.clip(np.asarray(rgb, dtype=np.float64), 0.0, 1.0)
-    lin = np.where(c <= 0.04045, c / 12.92, ((c + 0.055) / 1.055) ** 2.4)
+    lin = _srgb_decode(np.clip(np.asarray(rgb, dtype=np.float64), 0.0, 1.0))
     xyz = lin @ _M.T / _WHITE
     f = np.where(xyz > _D**3, np.cbrt(xyz), xyz / (3 * _D**2) + 4.0 / 29.0)
     return np.stack(
@@ -77,8 +86,7 @@ def lab_to_rgb(lab) -> np.ndarray:
     fz = fy - lab[..., 2] / 200.0
     f = np.stack([fx, fy, fz], axis=-1)
     xyz = np.where(f > _D, f**3, 3 * _D**2 * (f - 4.0 / 29.0)) * _WHITE
-    lin = np.clip(xyz @ _M_INV.T, 0.0, 1.0)
-    return np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * lin ** (1 / 2.4) - 0.055)
+    return _srgb_encode(np.clip(xyz @ _M_INV.T, 0.0, 1.0))
 
 
 def value_scale(dtype) -> float:
@@ -177,7 +185,7 @@ class ColorCorrection:
             _devignette(
                 colours.reshape(-1, colours.shape[-1]),
                 np.ascontiguousarray(mask).reshape(-1),
-                np.ascontiguousarray(uv, np.float64).reshape(-1, 2),
+                np.ascontiguousarray(uv).reshape(-1, 2),  # float32 views as is: no copy per tile
                 float(self.centre[i, 0]),
                 float(self.centre[i, 1]),
                 float(self.inv_norm[i]),
@@ -249,8 +257,8 @@ def _lab_finv(f):
 _LUT_N = 8192
 _LUT_TOP = 1.0625
 _LUT_X = np.linspace(0.0, _LUT_TOP, _LUT_N + 1)
-_LUT_DEC = np.where(_LUT_X <= 0.04045, _LUT_X / 12.92, ((_LUT_X + 0.055) / 1.055) ** 2.4)
-_LUT_ENC = np.where(_LUT_X <= 0.0031308, 12.92 * _LUT_X, 1.055 * _LUT_X ** (1 / 2.4) - 0.055)
+_LUT_DEC = _srgb_decode(_LUT_X)
+_LUT_ENC = _srgb_encode(_LUT_X)
 _LUT_F = np.where(_LUT_X > _D**3, np.cbrt(_LUT_X), _LUT_X / (3 * _D**2) + 4.0 / 29.0)
 _LUTS = np.ascontiguousarray(np.stack([_LUT_DEC, _LUT_ENC, _LUT_F]))
 
@@ -325,9 +333,10 @@ def linear_luminance(values: np.ndarray, dtype) -> np.ndarray:
     """Linear-light luminance (K,) of samples (K, bands) in the data's units: Rec. 709 weights of
     the sRGB-decoded first three bands of RGB data, the first band (taken as linear) otherwise."""
     v = np.asarray(values, dtype=np.float64)
+    if v.ndim != 2 or v.shape[1] < 1:
+        raise InputError(f"linear_luminance: samples must be (K, bands), got shape {v.shape}")
     if uses_lab(v.shape[1]):
-        x = np.clip(v[:, :3] / value_scale(dtype), 0.0, 1.0)
-        lin = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+        lin = _srgb_decode(np.clip(v[:, :3] / value_scale(dtype), 0.0, 1.0))
         return lin @ np.array([0.2126, 0.7152, 0.0722])
     return v[:, 0] / value_scale(dtype)
 
@@ -337,14 +346,16 @@ def devignette_values(values: np.ndarray, factor: np.ndarray, dtype) -> np.ndarr
     :func:`_devignette`), in the data's units (float64)."""
     v = np.array(values, dtype=np.float64)
     f = np.asarray(factor, dtype=np.float64)
+    if v.ndim != 2 or f.shape != (len(v),) or not np.all(f > 0):
+        raise InputError(
+            "devignette_values: expected samples (K, bands) and K positive factors, "
+            f"got {v.shape} and {f.shape}"
+        )
     start = 0
     if uses_lab(v.shape[1]):
         sc = value_scale(dtype)
-        x = np.clip(v[:, :3] / sc, 0.0, 1.0)
-        lin = np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4) / f[:, None]
-        lin = np.clip(lin, 0.0, None)
-        enc = np.where(lin <= 0.0031308, 12.92 * lin, 1.055 * lin ** (1 / 2.4) - 0.055)
-        v[:, :3] = enc * sc
+        lin = _srgb_decode(np.clip(v[:, :3] / sc, 0.0, 1.0)) / f[:, None]
+        v[:, :3] = _srgb_encode(np.clip(lin, 0.0, None)) * sc
         start = 3
     v[:, start:] /= f[:, None]
     return v
@@ -388,6 +399,8 @@ def estimate_vignetting(
         raise InputError("estimate_vignetting: observation arrays differ in length")
     if len(img) and (img.min() < 0 or img.max() >= n):
         raise InputError("estimate_vignetting: image index out of range")
+    if n and cam_of.min() < 0:
+        raise InputError("estimate_vignetting: image_camera holds a negative camera index")
     n_cam = int(cam_of.max()) + 1 if n else 0
     coef = np.zeros((n, 2))
     stats: dict = {"cameras": {}}

@@ -412,8 +412,10 @@ def reconstruct_block(
     elif camera_file:
         inc.refine_focal_early = False
     sel = matches.selection
-    # a second matching pass may follow: the final adjustments wait for it (made once, at the end)
+    # a second matching pass may follow: the final adjustments wait for it (made once, at the end);
+    # the reconstruction's progress is then split: registration, that matching, the rest
     may_retry = sel.strategy != "exhaustive"
+    parts = Steps(steps[1], [7, 1, 2])
     rec = reconstruct(
         tracks.track,
         tracks.image,
@@ -421,7 +423,7 @@ def reconstruct_block(
         image_camera,
         cams,
         inc,
-        steps[1],
+        parts[0] if may_retry else steps[1],
         features,
         tracks.feature,
         finalize=not may_retry,
@@ -436,17 +438,17 @@ def reconstruct_block(
         )
     if extra:
         check(prog)
-        prog.update(
-            0.85, f"matching {len(missing)} unregistered image(s) against all others ({len(extra)} pairs)"
+        parts[1].update(
+            0.0, f"matching {len(missing)} unregistered image(s) against all others ({len(extra)} pairs)"
         )
-        more, _ = match_pairs(features, np.array(extra), matches.per_image_cams)
+        more, _ = match_pairs(features, np.array(extra), matches.per_image_cams, progress=parts[1])
         results = results + more
         n_verified = sum(r.ok for r in results)
         tracks = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)
         # go on from the block registered so far (its poses; every track triangulated anew)
         rec = reconstruct(
-            tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, None, features, tracks.feature,
-            start=rec,
+            tracks.track, tracks.image, tracks.xy, image_camera, cams, inc, parts[2], features,
+            tracks.feature, start=rec,
         )  # fmt: skip
         warnings.append(
             f"second matching pass for {len(missing)} image(s): {len(extra)} more pairs, "
@@ -455,7 +457,7 @@ def reconstruct_block(
     elif not rec.stats.get("finalized", True):
         # its own observations (with those guided registration added): points and inliers are kept
         rec = reconstruct(
-            rec.obs_track, rec.obs_image, rec.obs_xy, image_camera, cams, inc, None, features,
+            rec.obs_track, rec.obs_image, rec.obs_xy, image_camera, cams, inc, parts[2], features,
             rec.obs_feature, start=rec, register=False,
         )  # fmt: skip
     times["reconstruction"] = time.perf_counter() - t
