@@ -233,8 +233,16 @@ def _median_view(samples: np.ndarray) -> np.ndarray:
         return np.nanmedian(samples, axis=0).astype(np.float32)
 
 
+def _plane_need(search, lo, hi, gaps, a: int) -> np.ndarray:
+    """The cells that search absolute level ``a``: inside their window and outside its gap."""
+    need = search & (lo <= a) & (a <= hi)
+    if gaps is not None:
+        need &= ~((gaps[0] <= a) & (a <= gaps[1]))
+    return need
+
+
 def _dense_sweep(
-    images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled
+    images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps=None
 ) -> int:
     """Costs plane by plane, each on the bounding box of the cells that search it (every measure)."""
     rows, cols = search.shape
@@ -248,7 +256,7 @@ def _dense_sweep(
     for a in range(a_min, a_max + 1):
         if cancelled is not None and cancelled():
             break
-        need = search & (lo <= a) & (a <= hi)
+        need = _plane_need(search, lo, hi, gaps, a)
         rr = np.nonzero(need.any(axis=1))[0]
         if rr.size == 0:
             continue
@@ -271,7 +279,9 @@ def _dense_sweep(
     return evaluated
 
 
-def _sweep(images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled) -> int:
+def _sweep(
+    images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps=None
+) -> int:
     """Costs plane by plane on the cells that search each plane only (:mod:`.sweep`, gradient measure)."""
     from ..sgm.cost import DEFAULT_MIN_VALID
     from .sweep import PlaneSweep, gradient_scales
@@ -285,7 +295,7 @@ def _sweep(images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, pa
     for a in range(a_min, a_max + 1):
         if cancelled is not None and cancelled():
             break
-        need = search & (lo <= a) & (a <= hi)
+        need = _plane_need(search, lo, hi, gaps, a)
         if not need.any():
             continue
         sweep.plane(x0, y0, res, z_base + a * dz, need, a, z0, cost)
@@ -320,8 +330,14 @@ def match_tile(
     params: TileParams,
     guide_z: np.ndarray | None = None,
     cancelled=None,
+    gap_lo: np.ndarray | None = None,
+    gap_hi: np.ndarray | None = None,
 ) -> TileResult:
     """Match one tile: ``lo``/``hi`` (rows, cols) int32 absolute level windows (lo > hi: no search).
+
+    ``gap_lo``/``gap_hi``: levels inside a cell's window that it does not search
+    (:func:`~.levels.refine_bands`; ``gap_lo > gap_hi``: none). A minimum next to a
+    gap is rejected like one on the window's border: the surface lies in the gap.
 
     ``guide_z``: heights of the coarser level at these cells; the images sampled
     there (median over the views) form the guide of the intensity-adaptive P2.
@@ -343,20 +359,24 @@ def match_tile(
     z0 = np.where(search, np.clip(centre - nd // 2, None, lo), 0)
     z0 = np.where(search, np.maximum(z0, hi - nd + 1), 0).astype(np.int32)
     cost = np.full((rows, cols, nd), COST_MAX, np.uint16)
-    if params.measure == "gradient" and SPARSE_SWEEP:
-        evaluated = _sweep(
-            images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled
-        )
-    else:
-        evaluated = _dense_sweep(
-            images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled
-        )
+    gaps = None
+    if gap_lo is not None and gap_hi is not None:
+        if np.shape(gap_lo) != (rows, cols) or np.shape(gap_hi) != (rows, cols):
+            raise ValueError(f"match_tile: gap_lo/gap_hi must be {(rows, cols)}, got {np.shape(gap_lo)}")
+        if (gap_lo <= gap_hi).any():
+            gaps = (gap_lo, gap_hi)
+    sweep = _sweep if params.measure == "gradient" and SPARSE_SWEEP else _dense_sweep
+    evaluated = sweep(
+        images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps
+    )
     guide = None if guide_z is None else _median_view(sample_surface(images, x0, y0, res, guide_z))
     S = aggregate(cost, params.p1, params.p2, params.paths, z0, guide=guide)
     level, conf = select(S, z0, params.uniqueness, valid=valid_cells(cost) & search)
     del S
     li = np.rint(np.nan_to_num(level, nan=-1e9)).astype(np.int64)
     edge = np.isfinite(level) & ((li <= lo) | (li >= hi))
+    if gaps is not None:
+        edge |= np.isfinite(level) & (gaps[0] <= gaps[1]) & ((li == gaps[0] - 1) | (li == gaps[1] + 1))
     level[edge] = np.nan
     conf[edge] = np.nan
     if params.median > 1:

@@ -52,7 +52,7 @@ from ..parallel import (
 )
 from ..progress import Progress, as_progress
 from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
-from .levels import MAX_BAND, LevelPlan, coarse_windows, plan_levels, refine_windows
+from .levels import MAX_BAND, LevelPlan, coarse_windows, plan_levels, refine_bands
 from .matching import TileParams, choose_images, sample_surface
 from .systems import reference_systems, system_views
 from .tiles import TileContext, TileTask, osgm_tile_task, task_memory
@@ -311,8 +311,11 @@ class _LevelTasks(Sequence):
                 None if self.zsw is None else tuple(w[r0 : r0 + nr, c0 : c0 + nc] for w in self.zsw),
             )
             guide = None
+            glo = ghi = None
         else:
-            lo, hi = refine_windows(plan, lv, self.prev_z, (r0, c0, nr, nc))
+            lo, hi, glo, ghi = refine_bands(plan, lv, self.prev_z, (r0, c0, nr, nc))
+            if not plan.gaps(lv):
+                glo = ghi = None
             assert self.prev_filled is not None
             guide = _interpolate(self.prev_filled, (r0, c0, nr, nc)) if self.cfg.adaptive_p2 else None
         search = lo <= hi
@@ -331,6 +334,8 @@ class _LevelTasks(Sequence):
             plan.dz(lv),
             self.params,
             guide,
+            glo,
+            ghi,
         )
 
 

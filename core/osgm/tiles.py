@@ -95,6 +95,8 @@ class TileTask:
     dz: float
     params: TileParams
     guide: np.ndarray | None  # (rows, cols) float32 heights of the coarser level, or None
+    gap_lo: np.ndarray | None = None  # (rows, cols) int32 levels not searched (levels.refine_bands)
+    gap_hi: np.ndarray | None = None
 
     def inner(self) -> tuple[slice, slice]:
         r = self.core[0] - self.outer[0]
@@ -119,6 +121,8 @@ class TileTask:
                 float(self.dz),
                 dataclasses.asdict(self.params),
                 self.guide,
+                self.gap_lo,
+                self.gap_hi,
             )
         ).hexdigest()
 
@@ -151,6 +155,8 @@ def osgm_tile_task(ctx: TileContext, task: TileTask) -> tuple[np.ndarray, np.nda
         task.params,
         task.guide,
         current_cancel(),
+        task.gap_lo,
+        task.gap_hi,
     )
     ins = task.inner()
     return np.ascontiguousarray(res.z[ins]), np.ascontiguousarray(res.confidence[ins])

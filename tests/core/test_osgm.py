@@ -20,7 +20,7 @@ from truortho.core.errors import CancelledError, InputError, MissingFileError  #
 from truortho.core.geometry import project_points  # noqa: E402
 from truortho.core.grid import RasterGrid  # noqa: E402
 from truortho.core.osgm import OsgmConfig, OsgmOutputs, plan_levels, reference_systems, run_osgm  # noqa: E402
-from truortho.core.osgm.levels import MAX_BAND, refine_windows  # noqa: E402
+from truortho.core.osgm.levels import MARGIN_STEPS, MAX_BAND, refine_bands, refine_windows  # noqa: E402
 from truortho.core.osgm.views import monotonic_radius2, plane_map  # noqa: E402
 from truortho.core.progress import CallbackProgress  # noqa: E402
 from truortho.core.rasterio_io import read_raster  # noqa: E402
@@ -95,6 +95,71 @@ def test_level_plan_and_refined_windows():
     assert z(lo[10, 20]) <= 0.0 <= z(hi[10, 20]) and hi[10, 20] - lo[10, 20] < 30
     assert z(lo[100, 100]) <= 0.0 <= z(hi[100, 100])  # a hole takes its neighbours' range
     assert (hi - lo + 1).max() <= MAX_BAND
+
+
+def test_refined_bands_skip_the_heights_between_two_surfaces():
+    grid = RasterGrid(0.0, 100.0, 0.25, 400, 400)
+    plan = plan_levels(-5.0, 55.0, 0.25, grid)
+    z = lambda a: plan.z_base + a * plan.dz(0)  # noqa: E731
+    coarse = np.zeros(plan.grid(grid, 1).shape, np.float32)
+    coarse[:, 100:] = 10.0  # a wall: ground at 0, a roof at 10 m
+    coarse[:, 150:] = 10.0 + 0.5 * np.arange(coarse.shape[1] - 150)[None, :] * 0.5  # a pitched roof from it
+    coarse[20, 20] = np.nan
+    lo, hi, glo, ghi = refine_bands(plan, 0, coarse, (0, 0, 400, 400))
+    assert np.array_equal((lo, hi), refine_windows(plan, 0, coarse, (0, 0, 400, 400)))
+    margin = MARGIN_STEPS * plan.dz(1)
+    # at the wall: both surfaces and their margins searched, the heights between them skipped
+    r, c = 10, 199
+    assert z(lo[r, c]) <= -margin and z(hi[r, c]) >= 10.0 + margin
+    assert glo[r, c] <= ghi[r, c]
+    assert z(glo[r, c] - 1) >= margin and z(ghi[r, c] + 1) <= 10.0 - margin
+    assert 5.0 > z(glo[r, c]) and z(ghi[r, c]) > 5.0
+    # flat ground, a hole, and the pitched roof (its heights change by less than two margins
+    # from cell to cell): no gap
+    for r, c in ((10, 20), (40, 40), (10, 330)):
+        assert glo[r, c] > ghi[r, c], (r, c)
+    assert ((glo > ghi) | ((lo < glo) & (ghi < hi))).all()  # a gap always lies inside the band
+    # the first refined level searches whole bands (the coarsest level's blunders are corrected there)
+    assert len(plan.levels) >= 3 and not plan.gaps(plan.levels[0]) and not plan.gaps(plan.levels[1])
+    assert all(plan.gaps(lv) for lv in plan.levels[2:])
+
+
+def test_a_gap_is_not_searched_and_a_minimum_beside_it_is_rejected(small_scene):
+    import dataclasses
+
+    from truortho.core.osgm.matching import match_tile
+    from truortho.core.osgm.systems import reference_systems, system_views
+    from truortho.core.osgm.views import ImagePyramid
+
+    scene, folder = small_scene
+    o = scene.orientation
+    views = system_views(o, reference_systems(o, "none", 35.0)[0])
+    sizes = [(o.camera_of(im).width, o.camera_of(im).height) for im in o.images]
+    pyr = ImagePyramid([str(folder / im.name) for im in o.images], sizes)
+    res, dz, rows, cols = 0.25, 0.25, 40, 40  # local frame (the orientation's offset removed)
+    x0, y0 = -5.0, 5.0
+    X, Y = np.meshgrid(x0 + (np.arange(cols) + 0.5) * res, y0 - (np.arange(rows) + 0.5) * res)
+    truth = scene.height(np.column_stack([X.ravel(), Y.ravel()]) + scene.offset[:2]).reshape(rows, cols)
+    truth -= scene.offset[2]
+    z_base = float(np.floor(truth.min())) - 10.0
+    a_true = np.rint((truth - z_base) / dz).astype(np.int32)
+    lo = np.maximum(a_true - 30, 0).astype(np.int32)
+    hi = (a_true + 30).astype(np.int32)
+    params = dataclasses.replace(OsgmConfig(refine_edges=False, median=1).tile_params())
+    full = match_tile(views, pyr, x0, y0, res, lo, hi, z_base, dz, params)
+    assert np.nanmedian(np.abs(full.z - truth)) < 2 * dz
+    # a gap around the true surface: those levels are not searched; the minimum lands on a
+    # level beside the gap, which is rejected
+    g_lo, g_hi = (a_true - 5).astype(np.int32), (a_true + 5).astype(np.int32)
+    gap = match_tile(views, pyr, x0, y0, res, lo, hi, z_base, dz, params, gap_lo=g_lo, gap_hi=g_hi)
+    found = np.isfinite(gap.z)
+    assert found.mean() < 0.5 * np.isfinite(full.z).mean()
+    a = np.rint((gap.z[found] - z_base) / dz)
+    assert ((a < g_lo[found]) | (a > g_hi[found])).all()
+    # an empty gap (glo > ghi) changes nothing
+    none = match_tile(views, pyr, x0, y0, res, lo, hi, z_base, dz, params, gap_lo=hi + 1, gap_hi=hi)
+    assert np.array_equal(np.isfinite(none.z), np.isfinite(full.z))
+    assert np.allclose(none.z, full.z, equal_nan=True)
 
 
 def test_reference_systems_of_an_oblique_block():
