@@ -230,7 +230,7 @@ def run_pipeline(folder: str, checks: list[str], resolution: float, log) -> dict
     sys.path.insert(0, HERE)
     from real_blocks import picture, qgis_pipeline
 
-    wall = qgis_pipeline(args, folder, os.path.basename(folder))
+    wall, peak_mb = qgis_pipeline(args, folder, os.path.basename(folder))
 
     picture(products, os.path.join(HERE, "results", "scale", f"{os.path.basename(folder)}.jpg"))
     with open(os.path.join(products, "report.json")) as fh:
@@ -238,6 +238,7 @@ def run_pipeline(folder: str, checks: list[str], resolution: float, log) -> dict
     stages = next(t["rows"] for t in rep["tables"] if t["title"] == "Stages")
     return {
         "wall_s": round(wall, 1),
+        "peak_mb": round(peak_mb) if math.isfinite(peak_mb) else None,
         "stages": [[r[0], r[1], r[2]] for r in stages],
         "summary": rep["summary"],
     }
@@ -258,7 +259,9 @@ def table(rows: list[dict]) -> list[str]:
     for r in rows:
         st = {s[0]: s for s in r["run"]["stages"]}
         wall = r["run"]["wall_s"]
-        peak = max((s[2] for s in r["run"]["stages"] if s[2] is not None), default=float("nan"))
+        peak = r["run"].get("peak_mb")  # the qgis_process's peak RSS (else the stages' own)
+        if peak is None:
+            peak = max((s[2] for s in r["run"]["stages"] if s[2] is not None), default=float("nan"))
         cells = [str(r["photos"]), f"{r['megapixels']:.1f}", f"{r['area_m']:.0f}", f"{r['render_s']:.0f}",
                  f"{wall:.0f}", f"{wall / r['photos']:.2f}", f"{peak:.0f}"]  # fmt: skip
         cells += [f"{st[n][1]:.0f}" if n in st else "" for n in names]
