@@ -35,6 +35,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..jit import njit, pjit, prange
+from ..sgm.selection import finite_window
 
 #: Cells near a step considered (beyond the matching window's radius, SGM spreads fattening).
 REACH = 4
@@ -51,29 +52,18 @@ AFFECT = 2 * (REACH + 2)
 @njit
 def _side_heights(z, rows_idx, cols_idx, w, lo_out, hi_out, mid_out):
     """Median of the low and of the high heights in the window of each listed cell."""
-    rows, cols = z.shape
     buf = np.empty((2 * w + 1) ** 2)
     for n in range(rows_idx.shape[0]):
-        r = rows_idx[n]
-        c = cols_idx[n]
-        zmin = np.inf
-        zmax = -np.inf
-        k = 0
-        for rr in range(max(0, r - w), min(rows, r + w + 1)):
-            for cc in range(max(0, c - w), min(cols, c + w + 1)):
-                v = z[rr, cc]
-                if v == v:
-                    buf[k] = v
-                    k += 1
-                    zmin = min(zmin, v)
-                    zmax = max(zmax, v)
+        k = finite_window(z, rows_idx[n], cols_idx[n], w, buf)
         if k == 0:
             lo_out[n] = np.nan
             hi_out[n] = np.nan
             mid_out[n] = np.nan
             continue
-        mid = 0.5 * (zmin + zmax)
         vals = buf[:k]
+        zmin = vals.min()
+        zmax = vals.max()
+        mid = 0.5 * (zmin + zmax)
         lo_out[n] = np.median(vals[vals <= mid])
         hi_out[n] = np.median(vals[vals > mid]) if zmax > mid else zmax
         mid_out[n] = mid

@@ -38,6 +38,7 @@ import numpy as np
 from ..errors import InputError
 from ..grid import RasterGrid
 from ..jit import njit
+from ..sgm.selection import finite_window
 
 #: Z steps the coarsest level may need for the whole range.
 COARSE_LEVELS = 64
@@ -154,13 +155,7 @@ def _widest_gaps(z, radius, margin, glo, ghi):
     buf = np.empty((2 * radius + 1) ** 2, np.float64)
     for r in range(rows):
         for c in range(cols):
-            m = 0
-            for rr in range(max(0, r - radius), min(rows, r + radius + 1)):
-                for cc in range(max(0, c - radius), min(cols, c + radius + 1)):
-                    v = z[rr, cc]
-                    if v == v:
-                        buf[m] = v
-                        m += 1
+            m = finite_window(z, r, c, radius, buf)
             glo[r, c] = np.nan
             ghi[r, c] = np.nan
             if m < 2:

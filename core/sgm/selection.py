@@ -160,6 +160,21 @@ def _median_of(buf, n):
     return 0.5 * (buf[h - 1] + buf[h])
 
 
+@njit
+def finite_window(x, r, c, rad, buf):
+    """Copies the finite values of the ``(2 rad + 1)^2`` window of ``x`` around ``(r, c)`` (cut at
+    the borders) into ``buf``; returns how many there are."""
+    rows, cols = x.shape
+    n = 0
+    for rr in range(max(0, r - rad), min(rows, r + rad + 1)):
+        for cc in range(max(0, c - rad), min(cols, c + rad + 1)):
+            v = x[rr, cc]
+            if v == v:
+                buf[n] = v
+                n += 1
+    return n
+
+
 @pjit
 def _median_kernel(x, rad, min_count, out):
     rows, cols = x.shape
@@ -169,13 +184,7 @@ def _median_kernel(x, rad, min_count, out):
             if x[r, c] != x[r, c]:
                 out[r, c] = np.nan
                 continue
-            n = 0
-            for rr in range(max(0, r - rad), min(rows, r + rad + 1)):
-                for cc in range(max(0, c - rad), min(cols, c + rad + 1)):
-                    v = x[rr, cc]
-                    if v == v:
-                        buf[n] = v
-                        n += 1
+            n = finite_window(x, r, c, rad, buf)
             if n < min_count:
                 out[r, c] = np.nan
             else:
