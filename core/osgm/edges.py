@@ -35,7 +35,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..jit import njit, pjit, prange
-from ..sgm.selection import finite_window
+from ..sgm.selection import _finite_window
 
 #: Cells near a step considered (beyond the matching window's radius, SGM spreads fattening).
 REACH = 4
@@ -54,7 +54,7 @@ def _side_heights(z, rows_idx, cols_idx, w, lo_out, hi_out, mid_out):
     """Median of the low and of the high heights in the window of each listed cell."""
     buf = np.empty((2 * w + 1) ** 2)
     for n in range(rows_idx.shape[0]):
-        k = finite_window(z, rows_idx[n], cols_idx[n], w, buf)
+        k = _finite_window(z, rows_idx[n], cols_idx[n], w, buf)
         if k == 0:
             lo_out[n] = np.nan
             hi_out[n] = np.nan

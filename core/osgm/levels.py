@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import InputError
 from ..grid import RasterGrid
 from ..jit import njit
-from ..sgm.selection import finite_window
+from ..sgm.selection import _finite_window
 
 #: Z steps the coarsest level may need for the whole range.
 COARSE_LEVELS = 64
@@ -155,7 +155,7 @@ def _widest_gaps(z, radius, margin, glo, ghi):
     buf = np.empty((2 * radius + 1) ** 2, np.float64)
     for r in range(rows):
         for c in range(cols):
-            m = finite_window(z, r, c, radius, buf)
+            m = _finite_window(z, r, c, radius, buf)
             glo[r, c] = np.nan
             ghi[r, c] = np.nan
             if m < 2:
@@ -172,7 +172,7 @@ def _widest_gaps(z, radius, margin, glo, ghi):
 
 def refine_windows(plan: LevelPlan, lv: int, coarse: np.ndarray, window) -> tuple[np.ndarray, np.ndarray]:
     """Windows of the cells ``window = (r0, c0, rows, cols)`` of level ``lv`` from level ``lv + 1``."""
-    lo, hi, _, _ = refine_bands(plan, lv, coarse, window)
+    lo, hi, _ = _refine(plan, lv, coarse, window)
     return lo, hi
 
 
@@ -180,12 +180,38 @@ def refine_bands(
     plan: LevelPlan, lv: int, coarse: np.ndarray, window
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Windows ``lo, hi`` of the cells ``window = (r0, c0, rows, cols)`` of level ``lv`` from level
-    ``lv + 1`` and the gap ``glo .. ghi`` inside each (levels not searched; ``glo > ghi``: none).
+    ``lv + 1`` (as :func:`refine_windows`) and the gap ``glo .. ghi`` inside each (levels not
+    searched; ``glo > ghi``: none).
 
     The gap is the widest run of levels of the band farther than the margin from every
     coarse value of the cell's neighbourhood (module docstring).
     """
-    r0, c0, nr, nc = window
+    lo, hi, (patch, ix, margin) = _refine(plan, lv, coarse, window)
+    gz_lo = np.empty(patch.shape, np.float64)
+    gz_hi = np.empty(patch.shape, np.float64)
+    _widest_gaps(np.ascontiguousarray(patch, np.float64), 2, float(margin), gz_lo, gz_hi)
+    d = plan.dz(lv)
+    with np.errstate(invalid="ignore"):
+        # the levels on both sides of the gap stay searched (outward rounding, as the band's)
+        glo = np.ceil((gz_lo[ix] - plan.z_base) / d) + 1
+        ghi = np.floor((gz_hi[ix] - plan.z_base) / d) - 1
+    has = np.isfinite(glo) & np.isfinite(ghi)
+    glo = np.where(has, np.maximum(glo, lo + 1), hi + 1)
+    ghi = np.where(has, np.minimum(ghi, hi - 1), hi)
+    return lo, hi, glo.astype(np.int32), ghi.astype(np.int32)
+
+
+def _refine(plan: LevelPlan, lv: int, coarse: np.ndarray, window):
+    """The windows of :func:`refine_windows` and what the gaps need: ``(lo, hi, (patch, ix, margin))``
+    with the coarse patch read, the index of each cell's coarse cell in it, and the margin (m)."""
+    coarse = np.asarray(coarse)
+    if coarse.ndim != 2:
+        raise InputError(f"refine_windows: the coarser level must be 2-D heights, got shape {coarse.shape}")
+    if len(window) != 4 or min(window[2], window[3]) < 1 or min(window[0], window[1]) < 0:
+        raise InputError(
+            f"refine_windows: window must be (r0 >= 0, c0 >= 0, rows >= 1, cols >= 1), got {window}"
+        )
+    r0, c0, nr, nc = (int(v) for v in window)
     m = 4  # coarse cells of context around the window
     cr0, cc0 = max(0, r0 // 2 - m), max(0, c0 // 2 - m)
     cr1 = min(coarse.shape[0], (r0 + nr - 1) // 2 + m + 1)
@@ -203,15 +229,4 @@ def refine_bands(
     cc = np.clip(np.arange(c0, c0 + nc) // 2 - cc0, 0, patch.shape[1] - 1)
     ix = np.ix_(rr, cc)
     lo_l, hi_l = _to_levels(plan, lv, lo[ix] - margin, hi[ix] + margin, patch[ix])
-    gz_lo = np.empty(patch.shape, np.float64)
-    gz_hi = np.empty(patch.shape, np.float64)
-    _widest_gaps(np.ascontiguousarray(patch, np.float64), 2, float(margin), gz_lo, gz_hi)
-    d = plan.dz(lv)
-    with np.errstate(invalid="ignore"):
-        # the levels on both sides of the gap stay searched (outward rounding, as the band's)
-        glo = np.ceil((gz_lo[ix] - plan.z_base) / d) + 1
-        ghi = np.floor((gz_hi[ix] - plan.z_base) / d) - 1
-    has = np.isfinite(glo) & np.isfinite(ghi)
-    glo = np.where(has, np.maximum(glo, lo_l + 1), hi_l + 1)
-    ghi = np.where(has, np.minimum(ghi, hi_l - 1), hi_l)
-    return lo_l, hi_l, glo.astype(np.int32), ghi.astype(np.int32)
+    return lo_l, hi_l, (patch, ix, margin)

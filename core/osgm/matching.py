@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
 from ..geometry.camera import Camera
 from ..sgm import COST_MAX, aggregate, median_filter, multi_image_cost, select, valid_cells
 from .views import ImagePyramid, plane_map, project
@@ -343,6 +344,17 @@ def match_tile(
     there (median over the views) form the guide of the intensity-adaptive P2.
     """
     rows, cols = lo.shape
+    gaps = None
+    if (gap_lo is None) != (gap_hi is None):
+        raise InputError("match_tile: gap_lo and gap_hi go together (both or neither)")
+    if gap_lo is not None and gap_hi is not None:
+        if np.shape(gap_lo) != (rows, cols) or np.shape(gap_hi) != (rows, cols):
+            raise InputError(
+                f"match_tile: gap_lo and gap_hi must be {(rows, cols)} like lo, got "
+                f"{np.shape(gap_lo)} and {np.shape(gap_hi)}"
+            )
+        if (gap_lo <= gap_hi).any():
+            gaps = (gap_lo, gap_hi)
     search = lo <= hi
     nan = np.full((rows, cols), np.nan, np.float32)
     if not search.any():
@@ -359,12 +371,6 @@ def match_tile(
     z0 = np.where(search, np.clip(centre - nd // 2, None, lo), 0)
     z0 = np.where(search, np.maximum(z0, hi - nd + 1), 0).astype(np.int32)
     cost = np.full((rows, cols, nd), COST_MAX, np.uint16)
-    gaps = None
-    if gap_lo is not None and gap_hi is not None:
-        if np.shape(gap_lo) != (rows, cols) or np.shape(gap_hi) != (rows, cols):
-            raise ValueError(f"match_tile: gap_lo/gap_hi must be {(rows, cols)}, got {np.shape(gap_lo)}")
-        if (gap_lo <= gap_hi).any():
-            gaps = (gap_lo, gap_hi)
     sweep = _sweep if params.measure == "gradient" and SPARSE_SWEEP else _dense_sweep
     evaluated = sweep(
         images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps

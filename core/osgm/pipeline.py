@@ -52,7 +52,7 @@ from ..parallel import (
 )
 from ..progress import Progress, as_progress
 from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
-from .levels import MAX_BAND, LevelPlan, coarse_windows, plan_levels, refine_bands
+from .levels import MAX_BAND, LevelPlan, coarse_windows, plan_levels, refine_bands, refine_windows
 from .matching import TileParams, choose_images, sample_surface
 from .systems import reference_systems, system_views
 from .tiles import TileContext, TileTask, osgm_tile_task, task_memory
@@ -313,8 +313,10 @@ class _LevelTasks(Sequence):
             guide = None
             glo = ghi = None
         else:
-            lo, hi, glo, ghi = refine_bands(plan, lv, self.prev_z, (r0, c0, nr, nc))
-            if not plan.gaps(lv):
+            if plan.gaps(lv):
+                lo, hi, glo, ghi = refine_bands(plan, lv, self.prev_z, (r0, c0, nr, nc))
+            else:
+                lo, hi = refine_windows(plan, lv, self.prev_z, (r0, c0, nr, nc))
                 glo = ghi = None
             assert self.prev_filled is not None
             guide = _interpolate(self.prev_filled, (r0, c0, nr, nc)) if self.cfg.adaptive_p2 else None

@@ -161,7 +161,7 @@ def _median_of(buf, n):
 
 
 @njit
-def finite_window(x, r, c, rad, buf):
+def _finite_window(x, r, c, rad, buf):
     """Copies the finite values of the ``(2 rad + 1)^2`` window of ``x`` around ``(r, c)`` (cut at
     the borders) into ``buf``; returns how many there are."""
     rows, cols = x.shape
@@ -184,7 +184,7 @@ def _median_kernel(x, rad, min_count, out):
             if x[r, c] != x[r, c]:
                 out[r, c] = np.nan
                 continue
-            n = finite_window(x, r, c, rad, buf)
+            n = _finite_window(x, r, c, rad, buf)
             if n < min_count:
                 out[r, c] = np.nan
             else:

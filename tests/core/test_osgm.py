@@ -533,3 +533,17 @@ def test_chunked_run_matches_one_run(tmp_path):
     assert len(np.unique(cells)) == len(pc)
     ortho = read_raster(tmp_path / "chunks_o.tif", band=None)[0]
     assert ((ortho.sum(axis=0) > 0) == np.isfinite(runs["chunks"])).mean() > 0.99
+
+
+def test_bands_and_gaps_name_bad_input(small_scene):
+    from truortho.core.osgm.matching import match_tile
+
+    grid = RasterGrid(0.0, 100.0, 0.25, 40, 40)
+    plan = plan_levels(-5.0, 55.0, 0.25, grid)
+    with pytest.raises(InputError, match="2-D heights"):
+        refine_bands(plan, 0, np.zeros(10), (0, 0, 4, 4))
+    with pytest.raises(InputError, match="window must be"):
+        refine_windows(plan, 0, np.zeros((20, 20)), (0, 0, 0, 4))
+    lo = np.zeros((4, 4), np.int32)
+    with pytest.raises(InputError, match="both or neither"):  # checked before any image is chosen
+        match_tile([], None, 0.0, 0.0, 0.25, lo, lo + 5, 0.0, 0.25, OsgmConfig().tile_params(), gap_lo=lo)
