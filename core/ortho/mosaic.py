@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FormatError, InputError
-from ..imagery import REC601, read_image_sized, read_level_window
+from ..imagery import REC601, read_image_level, read_level_window
 from ..jit import njit
 from .color import ColorCorrection, value_scale
 from .seams import feather_weights
@@ -101,33 +101,18 @@ class ImageStore:
         self._lock = threading.RLock()
 
     def _load(self, i: int, level: int) -> np.ndarray:
-        """Decode image ``i`` (level 0) or halve its level ``level - 1`` (outside the lock)."""
-        if level == 0:
-            img = read_image_sized(self.paths[i], self.sizes[i])
-            nb = 1 if img.ndim == 2 else img.shape[2]
-            if nb != self.bands or img.dtype != self.dtype:
-                raise FormatError(
-                    self.paths[i],
-                    f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
-                )
-            with self._lock:
-                self.reads += 1
-        else:
-            import cv2
-
-            src = self.get(i, level - 1)
-            h, w = src.shape[:2]
-            nw, nh = max(1, (w + 1) // 2), max(1, (h + 1) // 2)
-            if src.ndim == 3 and src.shape[2] > 4:
-                img = np.stack(
-                    [
-                        cv2.resize(src[:, :, c], (nw, nh), interpolation=cv2.INTER_AREA)
-                        for c in range(src.shape[2])
-                    ],
-                    -1,
-                )
-            else:
-                img = cv2.resize(src, (nw, nh), interpolation=cv2.INTER_AREA)
+        """Decode image ``i`` at ``level`` (outside the lock): only that level is cached, so the
+        cache holds 4**level times more images of a coarse product (:func:`read_image_level`
+        decodes JPEGs directly at the reduced scale)."""
+        img = read_image_level(self.paths[i], self.sizes[i], level)
+        nb = 1 if img.ndim == 2 else img.shape[2]
+        if nb != self.bands or img.dtype != self.dtype:
+            raise FormatError(
+                self.paths[i],
+                f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
+            )
+        with self._lock:
+            self.reads += 1
         return np.ascontiguousarray(img)
 
     def _insert(self, key, img: np.ndarray) -> None:
@@ -157,9 +142,9 @@ class ImageStore:
         if not self.windowed[i] or not len(uv):
             img = self.get(i, level)
             return img, (0, 0), (img.shape[1], img.shape[0])
-        W, H = self.sizes[i]
-        u = (uv[:, 0].astype(np.float64) + 0.5) * lw / W - 0.5
-        v = (uv[:, 1].astype(np.float64) + 0.5) * lh / H - 0.5
+        s = 0.5**level  # the levels' blocks stay on the stored pixel grid (imagery.halve_image)
+        u = (uv[:, 0].astype(np.float64) + 0.5) * s - 0.5
+        v = (uv[:, 1].astype(np.float64) + 0.5) * s - 0.5
         ok = np.isfinite(u) & np.isfinite(v)
         if not ok.any():
             img = self.get(i, level)
@@ -269,14 +254,14 @@ def _sample_candidates(views, store, res, needed, workers, out, lum_weights, fil
             return
         level = store.level_for(float(views.gsd[k]), res)
         uvk = views.uv[k]
-        img, origin, lsize = store.source(i, level, uvk[m] if store.windowed[i] else uvk[:0, 0])
-        W, H = store.sizes[i]
+        img, origin, _ = store.source(i, level, uvk[m] if store.windowed[i] else uvk[:0, 0])
+        s = 0.5**level  # pixel centres x' = (x + 0.5) / 2**level - 0.5 (imagery.read_image_level)
         _bilinear_into(
             img.reshape(img.shape[0], img.shape[1], -1),
             uvk,
             m,
-            lsize[0] / W,
-            lsize[1] / H,
+            s,
+            s,
             float(origin[0]),
             float(origin[1]),
             lw,

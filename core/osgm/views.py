@@ -32,7 +32,7 @@ from ..imagery import (
     check_image_size,
     image_info,
     luminance,
-    read_image_sized,
+    read_image_level,
     read_level_window,
 )
 from ..jit import njit
@@ -180,16 +180,10 @@ class ImagePyramid:
         if key in self._cache:
             self._cache.move_to_end(key)
             return self._cache[key]
-        if level == 0:
-            img = read_image_sized(self.paths[i], self.sizes[i])
-            self.reads += 1
-            out = self._convert(img, colour)
-        else:
-            import cv2
-
-            prev = self._full(i, level - 1, colour)
-            h, w = prev.shape[:2]
-            out = cv2.resize(prev, ((w + 1) // 2, (h + 1) // 2), interpolation=cv2.INTER_AREA)
+        # only the level asked for is cached (JPEGs decode directly at up to 1/8 scale); the
+        # conversion to float comes before any area halving, which then does not round
+        out = read_image_level(self.paths[i], self.sizes[i], level, lambda img: self._convert(img, colour))
+        self.reads += 1
         self._put(key, out)
         return out
 

@@ -11,7 +11,16 @@ import pytest
 from truortho.core.errors import FormatError, InputError, MissingFileError
 from truortho.core.exif import focal_prior_px, read_exif
 from truortho.core.geometry import Camera
-from truortho.core.imagery import image_info, luminance, read_image, read_window, scaled_size
+from truortho.core.imagery import (
+    halve_image,
+    image_info,
+    level_size,
+    luminance,
+    read_image,
+    read_image_level,
+    read_window,
+    scaled_size,
+)
 
 DATA = Path(os.environ["TRUORTHO_DATA"])
 need_data = pytest.mark.skipif(not DATA.is_dir(), reason="shared data sets not available")
@@ -166,3 +175,75 @@ def test_no_exif_default_prior_and_orientation_rule():
     assert read_exif(b).orientation == 8
     assert read_image(b, scale=0.125).shape[:2] == (216, 288)
     assert (image_info(b).width, image_info(b).height) == (2304, 1728)
+
+
+def _textured(h, w, seed):
+    """A photo-like texture: luminance detail at every pyramid level (down to 2 px), smoother
+    colour (as a JPEG's subsampled chroma keeps it), no clipping."""
+    import cv2
+
+    rng = np.random.default_rng(seed)
+
+    def noise(s, bands):
+        n = rng.normal(0, 1, (h // s + 2, w // s + 2, bands)).astype(np.float32)
+        return cv2.resize(n, (w, h), interpolation=cv2.INTER_CUBIC).reshape(h, w, bands)
+
+    lum = 18 * noise(2, 1) + 18 * noise(5, 1) + 18 * noise(13, 1)
+    tint = 1.0 + 0.15 * noise(9, 3)
+    return np.clip(110 + lum * tint, 0, 255).astype(np.uint8)
+
+
+@pytest.mark.parametrize("grey", [False, True])
+def test_image_levels_of_a_jpeg_are_block_means(tmp_path, grey):
+    """JPEG levels 1..3 are decoded at the reduced scale, level 4 halved from level 3: the sizes are
+    the halvings rounded up (odd sizes) and the values the area means of the full image (within
+    JPEG rounding), the same as the area pyramid of the full decode."""
+    import cv2
+
+    img = _textured(151, 203, 3)
+    if grey:
+        img = img[:, :, 1].copy()
+    p = tmp_path / "t.jpg"
+    cv2.imwrite(str(p), img if grey else img[:, :, ::-1], [cv2.IMWRITE_JPEG_QUALITY, 95])
+    full = read_image(p)
+    chain = full.astype(np.float32)
+    for level in range(1, 5):
+        chain = halve_image(chain)
+        got = read_image_level(p, (203, 151), level)
+        assert got.dtype == np.uint8 and got.shape[1::-1] == level_size((203, 151), level)
+        assert got.ndim == (2 if grey else 3)
+        err = np.abs(got.astype(np.float32) - chain)
+        # the block means of the stored image, not a sample or a blur of it
+        assert err.mean() < 1.0 and np.percentile(err, 99) < 4.0, (level, err.mean())
+    assert np.array_equal(read_image_level(p, (203, 151), 0), full)
+    # a conversion before the halvings keeps the float precision of the means
+    lum = read_image_level(p, (203, 151), 4, luminance)
+    assert lum.dtype == np.float32 and lum.shape == (10, 13)
+
+
+def test_image_levels_of_png_and_tiff_and_bad_input(tmp_path, rgb_png):
+    import cv2
+    import rasterio
+
+    p, img = rgb_png  # 80 x 60
+    two = read_image_level(p, (80, 60), 2)
+    assert np.array_equal(two, halve_image(halve_image(img)))  # PNG: the exact area pyramid
+    tif = tmp_path / "t.tif"
+    with rasterio.open(tif, "w", driver="GTiff", width=80, height=60, count=3, dtype="uint8") as ds:
+        ds.write(np.moveaxis(img, -1, 0))
+    t2 = read_image_level(tif, (80, 60), 2)
+    assert t2.shape == (15, 20, 3) and np.abs(t2.astype(float) - two).mean() < 1.0
+    with pytest.raises(FormatError, match="rgb.png.*80 x 60.*camera says 81 x 60"):
+        read_image_level(p, (81, 60), 1)
+    with pytest.raises(InputError, match="level must be a whole number"):
+        read_image_level(p, (80, 60), -1)
+    with pytest.raises(MissingFileError, match="nope.jpg"):
+        read_image_level(tmp_path / "nope.jpg", (80, 60), 1)
+    bad = tmp_path / "bad.jpg"
+    bad.write_bytes(b"\xff\xd8\xff" + b"\0" * 50)
+    with pytest.raises(FormatError, match="bad.jpg"):
+        read_image_level(bad, (80, 60), 1)
+    cv2.imwrite(str(tmp_path / "x.png"), img)  # a PNG named .jpg decodes through the full path
+    (tmp_path / "x.png").rename(tmp_path / "png_named.jpg")
+    named = read_image_level(tmp_path / "png_named.jpg", (80, 60), 1)
+    assert np.array_equal(named, halve_image(img[:, :, ::-1]))

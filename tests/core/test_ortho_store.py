@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from truortho.core.errors import FormatError
+from truortho.core.imagery import level_size
 from truortho.core.ortho import mosaic
 from truortho.core.ortho.mosaic import ImageStore
 
@@ -23,13 +24,14 @@ def test_images_decode_in_parallel_and_once_each(monkeypatch):
     barrier = threading.Barrier(2, timeout=10)
     calls: list[str] = []
 
-    def decode(path, size):
+    def decode(path, size, level):
         calls.append(path)
         if path in ("img0.png", "img1.png"):
             barrier.wait()  # both decodes must be running at once, else this times out
-        return np.full((size[1], size[0], 3), int(path[3]), np.uint8)
+        w, h = level_size(size, level)
+        return np.full((h, w, 3), int(path[3]), np.uint8)
 
-    monkeypatch.setattr(mosaic, "read_image_sized", decode)
+    monkeypatch.setattr(mosaic, "read_image_level", decode)
     store = _store()
     with ThreadPoolExecutor(2) as pool:
         a, b = pool.map(store.get, [0, 1])
@@ -38,24 +40,25 @@ def test_images_decode_in_parallel_and_once_each(monkeypatch):
     with ThreadPoolExecutor(8) as pool:
         got = list(pool.map(store.get, [2] * 8))
     assert calls.count("img2.png") == 1 and all(g is got[0] for g in got) and store.reads == 3
+    # a level is decoded on its own (JPEGs at the reduced scale) and cached alone
     half = store.get(2, 1)
-    assert half.shape == (15, 20, 3) and store.reads == 3  # a level is made from the cached image
+    assert half.shape == (15, 20, 3) and store.reads == 4 and store.get(2, 1) is half
     assert store.get(0) is a and not store._pending
     copy = pickle.loads(pickle.dumps(store))
-    assert copy.reads == 3 and not copy._cache and not copy._pending
+    assert copy.reads == 4 and not copy._cache and not copy._pending
 
 
 def test_a_failed_decode_raises_in_every_waiting_thread_and_can_be_retried(monkeypatch):
     gate = threading.Event()
     state = {"fail": True}
 
-    def decode(path, size):
+    def decode(path, size, level):
         gate.wait(5)
         if state["fail"]:
             return np.zeros((size[1], size[0]), np.uint8)  # one band where the block has three
         return np.zeros((size[1], size[0], 3), np.uint8)
 
-    monkeypatch.setattr(mosaic, "read_image_sized", decode)
+    monkeypatch.setattr(mosaic, "read_image_level", decode)
     store = _store()
     with ThreadPoolExecutor(4) as pool:
         futures = [pool.submit(store.get, 0) for _ in range(4)]
@@ -69,7 +72,7 @@ def test_a_failed_decode_raises_in_every_waiting_thread_and_can_be_retried(monke
 
 
 def test_the_cache_stays_within_its_bound(monkeypatch):
-    monkeypatch.setattr(mosaic, "read_image_sized", lambda p, s: np.zeros((s[1], s[0], 3), np.uint8))
+    monkeypatch.setattr(mosaic, "read_image_level", lambda p, s, lv: np.zeros((s[1], s[0], 3), np.uint8))
     store = _store(n=5, max_bytes=2 * 40 * 30 * 3)
     for i in range(5):
         store.get(i)
