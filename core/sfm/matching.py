@@ -8,10 +8,19 @@ descriptors; FLANN randomised kd-trees beyond), keeps it when ``d1 < ratio * d2`
 first set's descriptor is also the nearest neighbour of its match (mutual
 nearest neighbours). :func:`match_pairs` runs that and the robust two-view
 geometry (:mod:`.twoview`) over a list of image pairs.
+
+The cost of a pair grows with the product of the two feature counts, yet only the features
+in the images' common part can match. :func:`match_pairs` therefore first matches the
+largest ``overlap_features`` of each image, fits a homography to them with a loose
+threshold, and matches only the features that fall inside the other image's frame mapped
+through it (grown by ``overlap_margin`` for relief): :func:`overlap_rows`. Pairs where that
+fails (few coarse matches, a scene too 3-D for one homography, little to save) are matched
+whole, as before.
 """
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 
@@ -50,6 +59,12 @@ class MatchConfig:
     bf_max: int = 8000
     flann_trees: int = 4
     flann_checks: int = 64
+    #: :func:`match_pairs`: largest features of a coarse first pass that finds where two images
+    #: overlap (:func:`overlap_rows`); 0 matches every feature against every other.
+    overlap_features: int = 1500
+    #: Margin around the other image's frame, mapped by the coarse homography, as a share of
+    #: that image's larger side (parallax of relief and off-plane objects, obliques).
+    overlap_margin: float = 0.15
 
     def validate(self) -> None:
         if not (isinstance(self.ratio, int | float) and 0 < self.ratio <= 1):
@@ -60,6 +75,10 @@ class MatchConfig:
             v = getattr(self, n)
             if not isinstance(v, int | np.integer) or v < 1:
                 raise InputError(f"{n} must be a positive integer, got {v!r}")
+        if not isinstance(self.overlap_features, int | np.integer) or self.overlap_features < 0:
+            raise InputError(f"overlap_features must be an integer >= 0, got {self.overlap_features!r}")
+        if not (isinstance(self.overlap_margin, int | float) and 0 <= self.overlap_margin <= 10):
+            raise InputError(f"overlap_margin must be in [0, 10], got {self.overlap_margin!r}")
 
 
 @fastjit
@@ -192,6 +211,97 @@ def match_descriptors(d1, d2, config: MatchConfig | None = None) -> tuple[np.nda
     return np.column_stack([i1, i2]).astype(np.int64), dist[i1, 0]
 
 
+#: Fewest coarse matches, and homography inliers among them, that locate an overlap.
+OVERLAP_MIN_MATCHES = 24
+#: Share of the coarse matches a homography must explain (within 3 % of the image diagonal)
+#: before the overlap it maps is trusted; a strongly 3-D pair (close range) fails and is matched whole.
+OVERLAP_MIN_INLIER_SHARE = 0.5
+#: The restricted product must save at least this share of the full one, else the pair is matched whole.
+OVERLAP_MIN_SAVING = 0.25
+
+
+def _inside(xy: np.ndarray, H: np.ndarray, width: int, height: int, margin: float) -> np.ndarray:
+    """Points mapped by ``H`` that land in the ``width x height`` frame grown by ``margin`` px."""
+    q = np.column_stack([xy, np.ones(len(xy))]) @ H.T
+    w = q[:, 2]
+    ok = w > 1e-9
+    u = np.where(ok, q[:, 0] / np.where(ok, w, 1.0), np.nan)
+    v = np.where(ok, q[:, 1] / np.where(ok, w, 1.0), np.nan)
+    with np.errstate(invalid="ignore"):
+        return ok & (u >= -margin) & (u <= width + margin) & (v >= -margin) & (v <= height + margin)
+
+
+def overlap_rows(fi: Features, fj: Features, config: MatchConfig | None = None):
+    """Rows of the features of two images that can lie in their common part, or None.
+
+    A coarse pass matches the ``overlap_features`` largest features of each image and fits a
+    homography to them with a loose threshold (3 % of the diagonal): the images' frames mapped
+    through it, grown by ``overlap_margin``, bound where matches can be. Returns
+    ``(rows_i, rows_j)`` (increasing) of the features inside the other image's mapped frame,
+    or None when the pair should be matched whole: too few features or coarse matches, a
+    homography that explains less than :data:`OVERLAP_MIN_INLIER_SHARE` of them (strong relief,
+    close range), a frame that maps across the horizon, or a saving under
+    :data:`OVERLAP_MIN_SAVING`. Deterministic (seeded).
+    """
+    import cv2
+
+    cfg = config or MatchConfig()
+    k = int(cfg.overlap_features)
+    ni, nj = len(fi), len(fj)
+    if k <= 0 or ni < 2 * k or nj < 2 * k:
+        return None
+    # the largest features: they repeat across views far more often than the strongest (on the
+    # 12 MP scale block the 1,500 largest of 8,000 found 30 % of a pair's matches, the strongest 5 %)
+    ti = np.sort(np.argsort(-fi.size, kind="stable")[:k])
+    tj = np.sort(np.argsort(-fj.size, kind="stable")[:k])
+    m0, _ = match_descriptors(fi.descriptor_rows(ti), fj.descriptor_rows(tj), cfg)
+    if len(m0) < OVERLAP_MIN_MATCHES:
+        return None
+    p, q = fi.xy[ti[m0[:, 0]]], fj.xy[tj[m0[:, 1]]]
+    diag = 0.5 * (math.hypot(fi.width, fi.height) + math.hypot(fj.width, fj.height))
+    cv2.setRNGSeed(0)
+    try:
+        H, mask = cv2.findHomography(p, q, cv2.RANSAC, 0.03 * diag, maxIters=2000, confidence=0.999)
+    except cv2.error:
+        return None
+    if H is None or mask is None:
+        return None
+    n_in = int(mask.sum())
+    if n_in < OVERLAP_MIN_MATCHES or n_in < OVERLAP_MIN_INLIER_SHARE * len(m0):
+        return None
+    try:
+        Hinv = np.linalg.inv(H)
+    except np.linalg.LinAlgError:
+        return None
+    corners_i = np.array([[0, 0], [fi.width, 0], [fi.width, fi.height], [0, fi.height]], float)
+    corners_j = np.array([[0, 0], [fj.width, 0], [fj.width, fj.height], [0, fj.height]], float)
+    for c, M in ((corners_i, H), (corners_j, Hinv)):
+        if not np.all(np.column_stack([c, np.ones(4)]) @ M[2] > 1e-9):
+            return None  # a frame corner maps behind the other camera: no bounded overlap
+    ri = np.flatnonzero(_inside(fi.xy, H, fj.width, fj.height, cfg.overlap_margin * max(fj.width, fj.height)))
+    rj = np.flatnonzero(
+        _inside(fj.xy, Hinv, fi.width, fi.height, cfg.overlap_margin * max(fi.width, fi.height))
+    )
+    if len(ri) * len(rj) > (1.0 - OVERLAP_MIN_SAVING) * ni * nj:
+        return None
+    return ri, rj
+
+
+def match_features(fi: Features, fj: Features, config: MatchConfig | None = None) -> tuple[np.ndarray, bool]:
+    """Matches ``(M, 2)`` of two images' features (sorted by the first index), and whether
+    they were searched in the overlap that :func:`overlap_rows` found only."""
+    cfg = config or MatchConfig()
+    rows = overlap_rows(fi, fj, cfg)
+    if rows is None:
+        m, _ = match_descriptors(fi.descriptors, fj.descriptors, cfg)
+        return m, False
+    ri, rj = rows
+    m, _ = match_descriptors(fi.descriptor_rows(ri), fj.descriptor_rows(rj), cfg)
+    if len(m):
+        m = np.column_stack([ri[m[:, 0]], rj[m[:, 1]]])
+    return m, True
+
+
 @dataclass
 class PairMatches:
     """Matching result of one image pair.
@@ -214,6 +324,8 @@ class PairMatches:
     geometry: TwoViewResult
     seconds_matching: float
     seconds_geometry: float
+    #: Matched within the overlap a coarse pass found (:func:`overlap_rows`), not whole.
+    restricted: bool = False
 
     @property
     def ok(self) -> bool:
@@ -280,7 +392,7 @@ def match_pairs(
         i, j = int(pair[0]), int(pair[1])
         fi, fj = features[i], features[j]
         t = time.perf_counter()
-        m, _ = match_descriptors(fi.descriptors, fj.descriptors, mcfg)
+        m, restricted = match_features(fi, fj, mcfg)
         t1 = time.perf_counter()
         cam_i = cameras[i] if cameras is not None else None
         cam_j = cameras[j] if cameras is not None else None
@@ -293,7 +405,7 @@ def match_pairs(
             pixel_scale=1.0 / min(fi.scale, fj.scale),
             matches=m,
         )
-        return PairMatches(i, j, len(m), geo, t1 - t, time.perf_counter() - t1)
+        return PairMatches(i, j, len(m), geo, t1 - t, time.perf_counter() - t1, restricted)
 
     for r in thread_map(one, P, threads, prog, lambda k, n: f"matching pair {k + 1} of {n}"):
         tm += r.seconds_matching
@@ -306,5 +418,6 @@ def match_pairs(
         "seconds": time.perf_counter() - t0,
         "seconds_matching": tm,
         "seconds_geometry": tg,
+        "overlap_restricted": sum(r.restricted for r in out),
     }
     return out, stats

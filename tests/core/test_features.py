@@ -244,3 +244,65 @@ def test_keypoint_positions_have_no_half_pixel_bias(tmp_path):
     ok = np.all(np.abs(s) < 1.0, axis=1)
     assert ok.sum() > 50
     np.testing.assert_allclose(np.median(s[ok], axis=0) / 2, [0.0, 0.0], atol=0.03)
+
+
+def _views_of_a_texture(tmp_path, shifts, angle_deg=4.0):
+    """Views (1200 x 900) of one large textured plane, shifted along x and slightly rotated, and
+    the affine maps from the first view to each."""
+    import cv2
+
+    rng = np.random.default_rng(7)
+    H, W = 1400, 3200
+    tex = np.zeros((H, W), np.float32)
+    for s in (3, 7, 17, 41):
+        n = rng.normal(0, 1, (H // s + 2, W // s + 2)).astype(np.float32)
+        tex += cv2.resize(n, (W, H), interpolation=cv2.INTER_CUBIC) * (s**0.5)
+    tex = np.clip(128 + 25 * tex / tex.std(), 0, 255).astype(np.uint8)
+    paths, maps = [], []
+    for n, dx in enumerate(shifts):
+        a = np.radians(angle_deg * n)
+        # view pixel -> texture pixel: rotate about the view centre, then shift
+        A = np.array([[np.cos(a), -np.sin(a), 0.0], [np.sin(a), np.cos(a), 0.0]])
+        A[:, 2] = [100 + dx, 250] + np.array([600, 450]) - A[:, :2] @ [600, 450]
+        view = cv2.warpAffine(tex, A, (1200, 900), flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
+        p = tmp_path / f"view{n}.png"
+        cv2.imwrite(str(p), view)
+        paths.append(p)
+        maps.append(np.vstack([A, [0, 0, 1]]))
+    return paths, maps
+
+
+def test_pairs_are_matched_in_their_overlap_only(tmp_path):
+    """The coarse pass finds the overlap of two views of a plane: the product shrinks, and the
+    matches consistent with the true mapping stay (a few more pass the ratio test, which now
+    meets fewer competitors). Disjoint views, and overlap_features 0, are matched whole."""
+    from truortho.core.sfm.matching import match_features, overlap_rows
+
+    paths, maps = _views_of_a_texture(tmp_path, [0, 600, 1900])
+    feats = [extract_features(p, FeatureConfig(max_features=4000)) for p in paths]
+    f0, f1 = feats[0], feats[1]
+    assert len(f0) > 3000 and len(f1) > 3000
+
+    def correct(m, k):  # matches within 2 px of the true mapping of view 0 to view k
+        T = np.linalg.inv(maps[k]) @ maps[0]
+        q = f0.xy[m[:, 0]] @ T[:2, :2].T + T[:2, 2]
+        return int((np.linalg.norm(q - feats[k].xy[m[:, 1]], axis=1) < 2.0).sum())
+
+    rows = overlap_rows(f0, f1, MatchConfig())
+    assert rows is not None
+    ri, rj = rows
+    assert len(ri) * len(rj) < 0.5 * len(f0) * len(f1)  # half the views overlap
+    # the kept features are those of the common part (x > 600 - margin in view 0)
+    assert f0.xy[ri, 0].min() > 600 - 0.15 * 1200 - 60
+    whole, w_restricted = match_features(f0, f1, MatchConfig(overlap_features=0))
+    part, p_restricted = match_features(f0, f1, MatchConfig())
+    assert p_restricted and not w_restricted
+    assert correct(part, 1) >= 0.98 * correct(whole, 1) and correct(whole, 1) > 300
+    assert np.all(np.diff(part[:, 0]) >= 0)  # sorted by the first index, as match_descriptors
+    # no overlap: no homography to trust, matched whole
+    assert overlap_rows(f0, feats[2], MatchConfig()) is None
+    res, st = match_pairs(feats, [(0, 1), (0, 2)])
+    assert st["overlap_restricted"] == 1 and res[0].restricted and not res[1].restricted
+    assert res[0].ok and not res[1].ok
+    with pytest.raises(InputError, match="overlap_margin"):
+        MatchConfig(overlap_margin=-1).validate()
