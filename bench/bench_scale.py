@@ -233,18 +233,23 @@ def run_pipeline(folder: str, checks: list[str], resolution: float, log) -> dict
     from real_blocks import picture, qgis_pipeline
 
     # a fresh feature cache: the run extracts the features as a user's first run does (a rerun on
-    # kept blocks would otherwise read them from the user's cache)
+    # kept blocks would otherwise read them from the user's cache); the compiled kernels stay in
+    # the user's numba cache (compiled once per install, not per block)
+    from truortho.core.cache import cache_dir
+
     cache = os.path.join(folder, "cache")
     shutil.rmtree(cache, ignore_errors=True)
-    before = os.environ.get("TRUORTHO_CACHE_DIR")
+    saved = {k: os.environ.get(k) for k in ("TRUORTHO_CACHE_DIR", "NUMBA_CACHE_DIR")}
+    os.environ["NUMBA_CACHE_DIR"] = saved["NUMBA_CACHE_DIR"] or str(cache_dir("numba"))
     os.environ["TRUORTHO_CACHE_DIR"] = cache
     try:
         wall, peak_mb = qgis_pipeline(args, folder, os.path.basename(folder))
     finally:
-        if before is None:
-            os.environ.pop("TRUORTHO_CACHE_DIR", None)
-        else:
-            os.environ["TRUORTHO_CACHE_DIR"] = before
+        for k, v in saved.items():
+            if v is None:
+                os.environ.pop(k, None)
+            else:
+                os.environ[k] = v
         shutil.rmtree(cache, ignore_errors=True)
 
     picture(products, os.path.join(HERE, "results", "scale", f"{os.path.basename(folder)}.jpg"))

@@ -105,15 +105,19 @@ class ImageStore:
         cache holds 4**level times more images of a coarse product (:func:`read_image_level`
         decodes JPEGs directly at the reduced scale)."""
         img = read_image_level(self.paths[i], self.sizes[i], level)
+        self._check(i, img)
+        with self._lock:
+            self.reads += 1
+        return np.ascontiguousarray(img)
+
+    def _check(self, i: int, img: np.ndarray) -> None:
+        """FormatError naming image ``i`` when its bands or data type differ from the block's."""
         nb = 1 if img.ndim == 2 else img.shape[2]
         if nb != self.bands or img.dtype != self.dtype:
             raise FormatError(
                 self.paths[i],
                 f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
             )
-        with self._lock:
-            self.reads += 1
-        return np.ascontiguousarray(img)
 
     def _insert(self, key, img: np.ndarray) -> None:
         """Cache ``img`` (under the lock), evicting the least recently used beyond ``max_bytes``."""
@@ -160,12 +164,7 @@ class ImageStore:
     def _read_window(self, i: int, level: int, x0: int, y0: int, w: int, h: int) -> np.ndarray:
         """Window of level ``level`` (:func:`~truortho.core.imagery.read_level_window`)."""
         img = read_level_window(self.paths[i], self.sizes[i], level, x0, y0, w, h)
-        nb = 1 if img.ndim == 2 else img.shape[2]
-        if nb != self.bands or img.dtype != self.dtype:
-            raise FormatError(
-                self.paths[i],
-                f"image has {nb} band(s) of {img.dtype}, the block {self.bands} band(s) of {self.dtype}",
-            )
+        self._check(i, img)
         with self._lock:
             self.window_reads += 1
         return img
