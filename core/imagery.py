@@ -166,11 +166,12 @@ def _decode_jpeg_reduced(path: str, level: int, bands: int) -> np.ndarray | None
     import cv2
 
     try:
+        with open(path, "rb") as fh:  # the signature first: another format is not read twice
+            if fh.read(3) != b"\xff\xd8\xff":
+                return None
         buf = np.fromfile(path, dtype=np.uint8)
     except OSError as exc:
         raise FormatError(path, f"cannot read the file ({exc})") from None
-    if buf.size < 3 or bytes(buf[:3]) != b"\xff\xd8\xff":
-        return None
     grey = {
         1: cv2.IMREAD_REDUCED_GRAYSCALE_2,
         2: cv2.IMREAD_REDUCED_GRAYSCALE_4,
@@ -204,7 +205,7 @@ def halve_image(img: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(cv2.resize(img, size, interpolation=cv2.INTER_AREA))
 
 
-def level_size(size: tuple[int, int], level: int) -> tuple[int, int]:
+def level_size(size, level: int) -> tuple[int, int]:
     """(width, height) of an image of ``size`` at pyramid ``level`` (halvings rounded up)."""
     w, h = (int(v) for v in size)
     for _ in range(int(level)):
@@ -221,7 +222,9 @@ def read_image_level(path, size, level: int, convert=None) -> np.ndarray:
     JPEGs are decoded directly at up to 1/8 scale (:data:`JPEG_DIRECT_LEVELS`; a fraction of
     the time and none of the memory of the full image); further levels, and other formats, are
     halved by area averaging (:func:`halve_image`). TIFF/VRT/JPEG 2000 files are read through
-    rasterio, decimated by averaging (with the file's overviews when it has them).
+    rasterio, decimated by averaging (with the file's overviews when it has them); there GDAL
+    fits the whole image to the rounded-up size, so for a size not divisible by ``2**l`` the grid
+    is stretched by ``W' 2**l / W`` instead of kept exact, as in :func:`read_level_window`.
 
     ``convert`` (optional) maps the decoded array before the area halvings (e.g. to float
     luminance, so that the averaging does not round to the file's integers).

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import FormatError, InputError
-from ..imagery import REC601, read_image_level, read_level_window
+from ..imagery import REC601, level_size, read_image_level, read_level_window
 from ..jit import njit
 from .color import ColorCorrection, value_scale
 from .seams import feather_weights
@@ -128,11 +128,8 @@ class ImageStore:
             self._bytes -= old.nbytes
 
     def level_size(self, i: int, level: int) -> tuple[int, int]:
-        """(width, height) of image ``i`` at ``level`` (halvings rounded up)."""
-        w, h = self.sizes[i]
-        for _ in range(level):
-            w, h = max(1, (w + 1) // 2), max(1, (h + 1) // 2)
-        return w, h
+        """(width, height) of image ``i`` at ``level`` (:func:`~truortho.core.imagery.level_size`)."""
+        return level_size(self.sizes[i], level)
 
     def source(self, i: int, level: int, uv: np.ndarray):
         """What to sample the full-resolution points ``uv`` (n, 2) from at ``level``.

@@ -31,6 +31,7 @@ from ..imagery import (
     _use_rasterio,
     check_image_size,
     image_info,
+    level_size,
     luminance,
     read_image_level,
     read_level_window,
@@ -210,10 +211,8 @@ class ImagePyramid:
         return self._value_max[i]
 
     def level_size(self, i: int, level: int) -> tuple[int, int]:
-        w, h = self.sizes[i]
-        for _ in range(level):
-            w, h = (w + 1) // 2, (h + 1) // 2
-        return w, h
+        """(width, height) of image ``i`` at ``level`` (:func:`~truortho.core.imagery.level_size`)."""
+        return level_size(self.sizes[i], level)
 
     def window(
         self, i: int, level: int, x0: int, y0: int, w: int, h: int, colour: bool = False

@@ -246,6 +246,7 @@ def overlap_rows(fi: Features, fj: Features, config: MatchConfig | None = None):
     import cv2
 
     cfg = config or MatchConfig()
+    cfg.validate()
     k = int(cfg.overlap_features)
     ni, nj = len(fi), len(fj)
     if k <= 0 or ni < 2 * k or nj < 2 * k:
