@@ -36,6 +36,10 @@ from ..errors import InputError
 from ..geometry.camera import Camera, undistort_points
 
 
+#: Rounds of refinement and inlier re-selection (:func:`_refine_and_reselect`).
+REFINE_ROUNDS = 3
+
+
 @dataclass
 class TwoViewConfig:
     """Options of :func:`estimate_two_view`.
@@ -224,6 +228,50 @@ def refine_pose(R, t, n1, n2, loss_scale: float):
     return pose(sol.x)
 
 
+def _in_front(R, t, n1, n2) -> np.ndarray:
+    """Points (normalised coordinates) triangulated in front of both cameras (midpoint method)."""
+    r1 = np.column_stack([n1, np.ones(len(n1))])
+    r2 = np.column_stack([n2, np.ones(len(n2))]) @ R  # R^T r2: camera-2 rays in camera-1 axes
+    c2 = -R.T @ t
+    # lambda1 r1 - lambda2 r2 = c2 in the least-squares sense (2 x 2 normal equations per point)
+    a11 = np.sum(r1 * r1, axis=1)
+    a12 = -np.sum(r1 * r2, axis=1)
+    a22 = np.sum(r2 * r2, axis=1)
+    b1 = r1 @ c2
+    b2 = -(r2 @ c2)
+    det = a11 * a22 - a12 * a12
+    ok = np.abs(det) > 1e-12 * a11 * a22
+    det = np.where(ok, det, 1.0)
+    l1 = (a22 * b1 - a12 * b2) / det
+    l2 = (a11 * b2 - a12 * b1) / det
+    return ok & (l1 > 0) & (l2 > 0)
+
+
+def _refine_and_reselect(res, n1, n2, finite, mask, sel, front, thr_n: float, cfg):
+    """Refine the pose on the inliers, then take as inliers every finite match within the threshold
+    of the refined model (Sampson distance), and repeat until the set is stable (at most
+    ``REFINE_ROUNDS`` times). The robust estimator's own inlier set depends on the sample it
+    ended with (measured on copr: 1906 or 2093 inliers of nearly the same 2,100 matches); the
+    refined model's does not. Returns the new ``mask, sel, front``."""
+    x1 = np.column_stack([n1, np.ones(len(n1))])
+    x2 = np.column_stack([n2, np.ones(len(n2))])
+    for _ in range(REFINE_ROUNDS):
+        R, t = refine_pose(res.R, res.t, n1[sel[front]], n2[sel[front]], thr_n)
+        d = np.full(len(n1), np.inf)
+        d[finite] = np.abs(_sampson(_skew(t) @ R, x1[finite], x2[finite]))
+        new = d < thr_n
+        new_sel = np.flatnonzero(new)
+        new_front = _in_front(R, t, n1[new_sel], n2[new_sel])
+        if new_front.sum() < front.sum():
+            break  # the refined model explains fewer matches: keep the estimator's
+        res.R, res.t = R, t
+        changed = not np.array_equal(new, mask)
+        mask, sel, front = new, new_sel, new_front
+        if not changed:
+            break
+    return mask, sel, front
+
+
 def estimate_two_view(
     xy1,
     xy2,
@@ -333,8 +381,11 @@ def estimate_two_view(
         front = pmask.ravel() > 0
         res.R, res.t = np.asarray(R, np.float64), np.asarray(t, np.float64).ravel()
         if cfg.refine:
-            res.R, res.t = refine_pose(res.R, res.t, n1[sel[front]], n2[sel[front]], thr / f)
+            mask, sel, front = _refine_and_reselect(res, n1, n2, finite, mask, sel, front, thr / f, cfg)
             res.matrix = _skew(res.t) @ res.R
+            res.inlier_mask = mask
+            res.n_inliers = int(mask.sum())
+            res.inliers = m[mask]
         res.n_cheiral = int(front.sum())
         res.median_angle_deg = _median_angle(n1[sel[front]], n2[sel[front]], res.R, res.t)
         if res.n_cheiral < cfg.min_inliers:
