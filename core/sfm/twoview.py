@@ -35,7 +35,6 @@ import numpy as np
 from ..errors import InputError
 from ..geometry.camera import Camera, undistort_points
 
-
 #: Rounds of refinement and inlier re-selection (:func:`_refine_and_reselect`).
 REFINE_ROUNDS = 3
 
