@@ -68,6 +68,10 @@ class OrientConfig:
     min_pair_tracks: int = 150
     #: Pair selection strategy: auto, exhaustive, gps, retrieval.
     pair_strategy: str = "auto"
+    #: The second matching pass pairs every image left out by the reconstruction with at most this
+    #: many others, nearest (GPS) or most similar (retrieval) first (:func:`second_pass_pairs`);
+    #: 0 pairs it with all. Bounded, the pass stays linear in the block size.
+    second_pass_partners: int = 40
     #: Refine the tie-point observations by least-squares matching against a master image at the
     #: working resolution after the adjustment, then adjust again (:mod:`truortho.core.gcp.tiepoints`;
     #: keeps every registered image's grey working image in memory).
@@ -368,6 +372,35 @@ def match_images(inputs: OrientInputs, cfg: OrientConfig, work_dir, steps, times
     return OrientMatches(features, fstats, cache, sel, results, mstats, n_verified, sizes, per_image_cams)
 
 
+def second_pass_pairs(sel, missing, partners: int) -> list[tuple[int, int]]:
+    """Pairs ``(i, j)``, ``i < j``, of a second matching pass for the images ``missing``.
+
+    Every missing image is paired with the images it was not paired with yet, the
+    ``partners`` nearest by GPS position (``sel.details["local_xy"]``) or most similar by
+    retrieval (``sel.details["similarity"]``) first; with neither, or ``partners`` 0, with all
+    of them. Matching a left-out image against the whole block made the pass quadratic in the
+    block size (a few left-out images of a 1,000-image block: thousands of pairs).
+    """
+    if int(partners) < 0:
+        raise InputError(f"second_pass_partners must be 0 (all) or positive, got {partners!r}")
+    n = int(sel.n_images)
+    tried = {(int(a), int(b)) for a, b in sel.pairs}
+    xy = sel.details.get("local_xy")
+    sim = sel.details.get("similarity")
+    out: set[tuple[int, int]] = set()
+    for m in (int(v) for v in missing):
+        others = np.array([j for j in range(n) if j != m and (min(m, j), max(m, j)) not in tried], np.int64)
+        if partners > 0 and len(others) > partners:
+            if xy is not None:
+                key = np.linalg.norm(np.asarray(xy)[others] - np.asarray(xy)[m], axis=1)
+                others = others[np.argsort(key, kind="stable")[:partners]]
+            elif sim is not None:
+                key = -np.asarray(sim)[m, others]
+                others = others[np.argsort(key, kind="stable")[:partners]]
+        out |= {(min(m, int(j)), max(m, int(j))) for j in others}
+    return sorted(out)
+
+
 def reconstruct_block(
     inputs: OrientInputs,
     matches: OrientMatches,
@@ -432,10 +465,7 @@ def reconstruct_block(
     extra = []
     if len(missing) and may_retry and rec.registered.sum() >= 2:
         # second chance: match the images left out against every image not paired with them yet
-        tried = {(int(a), int(b)) for a, b in sel.pairs}
-        extra = sorted(
-            {(min(int(m), j), max(int(m), j)) for m in missing for j in range(len(paths)) if j != m} - tried
-        )
+        extra = second_pass_pairs(sel, missing, cfg.second_pass_partners)
     if extra:
         check(prog)
         parts[1].update(

@@ -106,3 +106,30 @@ def test_second_pass_resumes_the_first_reconstruction():
     assert _centre_rmse(done, Cs, np.arange(12)) < 0.1
     with pytest.raises(InputError, match="another block"):
         reconstruct(tr, im, xy, np.zeros(n + 1, int), cams, start=rec1)
+
+
+def test_second_pass_pairs_are_bounded_and_nearest_first():
+    from truortho.core.sfm.pairs import PairSelection
+    from truortho.core.sfm.pipeline import second_pass_pairs
+
+    n = 300
+    xy = np.column_stack([np.arange(n) * 10.0, np.zeros(n)])  # a strip, 10 m apart
+    first = np.array([(i, j) for i in range(n) for j in range(i + 1, min(n, i + 3))])
+    sel = PairSelection(first, "gps", n, {"local_xy": xy})
+    extra = second_pass_pairs(sel, [150, 7], 20)
+    assert len(extra) == 40 and len(set(extra)) == 40
+    for m in (150, 7):
+        partners = sorted({a + b - m for a, b in extra if m in (a, b)})
+        tried = {a + b - m for a, b in first if m in (a, b)}
+        assert not tried & set(partners)
+        # the 20 nearest not yet paired (on the strip: distance rank, ties to the lower index)
+        cand = sorted((j for j in range(n) if j != m and j not in tried), key=lambda j: (abs(j - m), j))
+        assert partners == sorted(cand[:20])
+    # similarity ranking without positions; 0 = every image
+    sim = -np.abs(np.subtract.outer(np.arange(n), np.arange(n))).astype(float)
+    sel2 = PairSelection(first, "retrieval", n, {"similarity": sim})
+    p2 = second_pass_pairs(sel2, [150], 20)
+    assert len(p2) == 20 and max(abs(a + b - 300) for a, b in p2) <= 12
+    assert len(second_pass_pairs(sel2, [150], 0)) == n - 1 - 4
+    with pytest.raises(InputError, match="second_pass_partners"):
+        second_pass_pairs(sel, [1], -1)
