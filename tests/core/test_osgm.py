@@ -547,3 +547,39 @@ def test_bands_and_gaps_name_bad_input(small_scene):
     lo = np.zeros((4, 4), np.int32)
     with pytest.raises(InputError, match="both or neither"):  # checked before any image is chosen
         match_tile([], None, 0.0, 0.0, 0.25, lo, lo + 5, 0.0, 0.25, OsgmConfig().tile_params(), gap_lo=lo)
+
+
+def test_image_choice_keeps_two_views_where_the_candidates_give_them():
+    """A tile larger than a footprint: the 12 images the greedy choice prefers see the interior
+    four times over, while a rim strip is seen only by three frames that cover little else.
+    The points short of two views come first, within the cap; the cap is exceeded only when
+    ``max_images`` images cannot give every point its two views."""
+    from truortho.core.osgm.matching import MIN_VIEWS, _select
+
+    n_pts = 17 * 17
+    rim = np.zeros(n_pts, bool)
+    rim[:17] = True  # the tile's first lattice row
+    cand = []
+    for k in range(14):  # interior frames, all near nadir
+        seen = ~rim.copy()
+        seen[(np.arange(n_pts) + k) % 5 == 0] = False
+        cand.append((seen, 5.0 + k, 100.0, f"nadir{k}"))
+    for k in range(3):  # rim frames: each sees two thirds of the rim row and nothing else
+        seen = np.zeros(n_pts, bool)
+        seen[:17] = (np.arange(17) % 3) != k
+        cand.append((seen, 40.0 + k, 140.0, f"rim{k}"))
+    chosen = _select(cand, 12)
+    names = [v for _, _, v in chosen]
+    count = np.zeros(n_pts, int)
+    for c in cand:
+        if c[3] in names:
+            count += c[0]
+    avail = np.minimum(np.sum([c[0] for c in cand], axis=0), MIN_VIEWS)
+    assert np.all(count >= avail)
+    assert sum(n.startswith("rim") for n in names) >= 2 and len(names) == 12
+    # a cap of 2 cannot cover interior and rim twice: exceeded for the rim points alone
+    few = _select(cand, 2)
+    cnt2 = np.sum([c[0] for c in cand if c[3] in [v for _, _, v in few]], axis=0)
+    assert np.all(cnt2 >= avail) and len(few) == 6  # 3 interior + 3 rim frames: the fewest that do
+    # without a shortfall the cap holds
+    assert len(_select(cand[:14], 12)) == 12
