@@ -246,7 +246,8 @@ HELP: dict[str, dict] = {
             "P2": "Penalty for a larger height jump, above P1 and at most 3072; empty = 2048 (a jump then "
             "needs contrary evidence from two cells).",
             "MAX_IMAGES": "Largest number of images matched per tile (best coverage first, then the most "
-            "nadir); memory and time grow with it.",
+            "nadir; more only where fewer would leave part of the tile with under 2 views); memory and "
+            "time grow with it.",
             "TILE_SIZE": "Tile side in cells; memory grows with its square, the number of search heights "
             "and MAX_IMAGES.",
             "EXECUTOR": "Where the tiles are matched; the DSM and confidence are identical with every "
