@@ -24,7 +24,8 @@ blocks are deleted after each run unless ``--keep`` is given; ``--keep DIR --reu
 pipeline again on the blocks rendered there before (their ``render.json``: same seed and
 megapixels), which saves the rendering (about 11 s per 12 MP photo). With
 ``--write-docs`` the table goes into ``docs/benchmarks.md`` between the
-``scale`` markers (``scale-<MP>mp`` for photos of other than 12 MP), with the command, the commit and the machine.
+``scale`` markers (``scale-<MP>mp`` for photos of other than 12 MP), with
+the command, the commit and the machine.
 """
 
 from __future__ import annotations
