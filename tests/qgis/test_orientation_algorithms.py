@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,7 @@ from truortho.core.orientation import Image, Orientation, SparsePoints
 
 pytestmark = pytest.mark.qgis
 
-DATA = Path(__file__).resolve().parents[3] / "shared" / "data"
+DATA = Path(os.environ.get("TRUORTHO_DATA", ""))  # the shared data sets (set by tests/conftest.py)
 COPR_GCPS = DATA / "copr" / "gcp_list.txt"
 
 
