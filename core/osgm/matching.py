@@ -25,7 +25,7 @@ never computed.
 3. :func:`~truortho.core.sgm.aggregate` along 8 or 16 paths in XY (P1, P2;
    P2 lowered across edges of a guide image: the images sampled on the
    coarser level's surface, median over the views), :func:`~truortho.core.sgm.select`
-   (winner-take-all, parabola, uniqueness, confidence), minima on the border
+   (winner-take-all, equiangular sub-voxel fit, uniqueness, confidence), minima on the border
    of a cell's own window rejected (the surface lies outside it), and a
    NaN-aware median as an outlier test (:func:`median_outliers`).
 """

@@ -9,7 +9,7 @@ The pipeline on a cost volume ``(rows, cols, nd)``:
 2. :func:`aggregate` along 8 or 16 paths with penalties ``P1``/``P2``
    (per-cell ``P2`` from :func:`adaptive_p2`; per-cell level offsets ``z0``
    for variable search ranges) -> ``S`` (``uint16``);
-3. :func:`select`: winner-take-all, parabola refinement, uniqueness,
+3. :func:`select`: winner-take-all, equiangular sub-level fit, uniqueness,
    confidence; :func:`median_filter` (NaN-aware).
 
 :func:`match_rectified` runs exactly these kernels in disparity space.

@@ -47,7 +47,7 @@ def _select_kernel(s, z0, valid, uniq, reject_edges, level, conf):
             if 0 < best < nd - 1:
                 a = np.float64(s[r, c, best - 1])
                 b = np.float64(s[r, c, best + 1])
-                den = a - 2.0 * m + b
+                den = max(a - m, b - m)
                 if den > 0.0:
                     delta = 0.5 * (a - b) / den
                     delta = min(0.5, max(-0.5, delta))
@@ -109,10 +109,16 @@ def select(
     Returns
     -------
     level : (rows, cols) float32
-        Absolute level ``z0 + d* + delta``, ``delta`` in [-0.5, 0.5] the vertex
-        of the parabola through ``S[d* - 1], S[d*], S[d* + 1]`` (0 on the
-        window's first/last level or for a non-convex triple); NaN where
-        rejected or invalid.
+        Absolute level ``z0 + d* + delta``, ``delta`` in [-0.5, 0.5] the
+        equiangular (V) fit through ``S[d* - 1], S[d*], S[d* + 1]``:
+        ``(S[d*-1] - S[d*+1]) / (2 max(S[d*-1] - S[d*], S[d*+1] - S[d*]))``
+        (0 on the window's first/last level or for a flat triple); NaN where
+        rejected or invalid. Aggregated costs rise by about P1 per level on
+        both sides of their minimum, a V rather than a parabola: a parabola
+        pulls the result towards the nearest level (pixel locking). On the
+        copr block's OSGM DSM the fractions of the heights (in Z steps) were
+        1.6 times as frequent near 0 as on average with the parabola, and
+        within 0.85-1.18 of the average with this fit.
     confidence : (rows, cols) float32
         ``1 - m / m2`` in [0, 1] (0 when ``m2`` does not exist or is 0): how
         much the best level beats the best distinct alternative; NaN where
