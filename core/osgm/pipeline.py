@@ -55,7 +55,7 @@ from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
 from .levels import MAX_BAND, LevelPlan, coarse_windows, plan_levels, refine_bands, refine_windows
 from .matching import TileParams, choose_images, sample_surface
 from .systems import reference_systems, system_views
-from .tiles import TileContext, TileTask, osgm_tile_task, task_memory
+from .tiles import TileContext, TileTask, assemble_tiles, osgm_tile_task, task_memory
 from .views import ImagePyramid, check_images
 from .zrange import check_overlap, default_extent, default_resolution, known_heights, surface_range, z_range
 
@@ -287,6 +287,13 @@ class SystemResult:
     max_volume: int = 0  # largest rows x cols x nd of a task (cost volume cells)
 
 
+#: Cells on each side of a tile seam over which neighbouring tiles' heights are blended
+#: (:func:`~.tiles.assemble_tiles`; at most the tiles' margin).
+SEAM_BLEND = 16
+#: Largest spread of the tiles' heights at a seam cell, in Z steps of the level, that is blended.
+SEAM_TOLERANCE = 2.0
+
+
 class _LevelTasks(Sequence):
     """The tile tasks of one level, built when the executor asks for them (bounded memory)."""
 
@@ -295,6 +302,7 @@ class _LevelTasks(Sequence):
         self.params = plan.level_params(params, lv)
         self.cfg, self.prev_z, self.prev_filled, self.zsw = cfg, prev_z, prev_filled, zsw
         self.max_cells_levels = 0
+        self.blend = 0  # cells beyond the core each task returns for the seams (assemble_tiles)
 
     def __len__(self) -> int:
         return len(self.tiles)
@@ -338,6 +346,7 @@ class _LevelTasks(Sequence):
             guide,
             glo,
             ghi,
+            self.blend,
         )
 
 
@@ -379,13 +388,12 @@ def _match_system(
         if progress.cancelled():
             raise CancelledError("OSGM cancelled")
         g = plan.grid(grid, lv)
-        z = np.full(g.shape, np.nan, np.float32)
-        conf = np.full(g.shape, np.nan, np.float32)
         ts = int(cfg.tile_size)
         ov = max(16, ts // 8)
         side = ts + 2 * ov  # outer tile side, for the memory a task asks of the scheduler
         tiles = g.tiles(ts, ov)
         tasks = _LevelTasks(tiles, g, lv, plan, params, cfg, prev_z, prev_filled, z_surface_windows)
+        tasks.blend = min(SEAM_BLEND, ov)
         sub = SubProgress(progress, done_cells / total, (done_cells + g.rows * g.cols) / total)
         try:
             results = executor.map_tiles(
@@ -400,10 +408,7 @@ def _match_system(
             )
         except CancelledError:
             raise CancelledError("OSGM cancelled") from None
-        for tile, (zt, ct) in zip(tiles, results, strict=True):
-            core = tile.core_slices
-            z[core] = zt
-            conf[core] = ct
+        z, conf = assemble_tiles(g.shape, tiles, results, tasks.blend, SEAM_TOLERANCE * plan.dz(lv))
         n_tiles += len(tiles)
         done_cells += g.rows * g.cols
         max_volume = max(max_volume, tasks.max_cells_levels)
@@ -755,7 +760,7 @@ class _RunInfo:
 #: Bytes per finest-level cell that a chunk holds at once: the levels' heights and confidences
 #: (float32, the coarser levels add a third), the filled guide, the world DSM and confidence,
 #: the colours, and the chunk's share of the point cloud (xyz float64, colour, confidence, id).
-CHUNK_BYTES_PER_CELL = 96
+CHUNK_BYTES_PER_CELL = 96 + 24  # + the seam blending's accumulators (assemble_tiles)
 
 
 def plan_chunks(grid: RasterGrid, cfg: OsgmConfig, top_level: int):

@@ -583,3 +583,54 @@ def test_image_choice_keeps_two_views_where_the_candidates_give_them():
     assert np.all(cnt2 >= avail) and len(few) == 6  # 3 interior + 3 rim frames: the fewest that do
     # without a shortfall the cap holds
     assert len(_select(cand[:14], 12)) == 12
+
+
+def test_tile_seams_are_blended_where_the_tiles_agree_and_cut_where_they_do_not():
+    """Neighbouring tiles match with different images and borders: their heights differ slightly
+    at a seam, which a hard cut shows as a straight line on the tile grid. Within the blend band
+    the heights ramp from one tile to the other where they agree within the tolerance; where they
+    do not (a wall placed a cell apart), the core owner's height stays (no height between two
+    surfaces); validity and confidence are the owner's."""
+    from truortho.core.osgm.tiles import assemble_tiles, blend_window
+
+    grid = RasterGrid(0.0, 30.0, 1.0, 30, 60, "EPSG:32633")
+    tiles = grid.tiles(30, 8)
+    assert len(tiles) == 2
+    rng = np.random.default_rng(3)
+    base = rng.normal(0.0, 0.01, (30, 60))
+    offset = [0.0, 0.08]  # the second tile reads 8 cm higher
+    wall = [np.zeros((30, 60)), np.zeros((30, 60))]
+    wall[0][20:, :] = 5.0  # a wall across the seam, placed 1 cell apart by the two tiles
+    wall[1][21:, :] = 5.0
+
+    def results(blend, with_wall=False):
+        out = []
+        for k, t in enumerate(tiles):
+            r0, c0, nr, nc = blend_window(t.core, t.outer, blend)
+            z = (base + offset[k] + (wall[k] if with_wall else 0.0))[r0 : r0 + nr, c0 : c0 + nc]
+            z = z.astype(np.float32)
+            if k == 1 and blend:
+                z[0, 0] = np.nan  # a hole in the neighbour's margin leaves no hole in the owner's core
+            out.append((z, np.full((nr, nc), 0.5 + 0.1 * k, np.float32)))
+        return out
+
+    hard, conf = assemble_tiles(grid.shape, tiles, results(0), 0, 0.2)
+    soft, conf2 = assemble_tiles(grid.shape, tiles, results(6), 6, 0.2)
+    np.testing.assert_array_equal(conf, conf2)
+    assert np.isfinite(soft).all()
+    truth = base + np.where(np.arange(60) < 30, 0.0, 0.08)[None, :]
+    np.testing.assert_array_equal(hard, truth.astype(np.float32))
+    # away from the seam the owner's heights are kept exactly
+    np.testing.assert_array_equal(soft[:, :20], hard[:, :20])
+    np.testing.assert_array_equal(soft[:, 40:], hard[:, 40:])
+    # across the seam: the 8 cm step is spread over the band, no column step above 1/6 of it + noise
+    step_hard = np.abs(np.diff(hard.mean(axis=0)))[29]
+    steps_soft = np.abs(np.diff(soft.mean(axis=0)))
+    assert step_hard > 0.07
+    assert steps_soft.max() < 0.08 / 6 + 0.01
+    # a wall placed differently by the two tiles: on its row each side keeps its owner's height
+    cut, _ = assemble_tiles(grid.shape, tiles, results(6, True), 6, 0.2)
+    for c in (26, 29, 30, 33):
+        k = 0 if c < 30 else 1
+        assert cut[20, c] == pytest.approx(base[20, c] + offset[k] + wall[k][20, c], abs=1e-6)
+    assert cut[20, 29] > 4.9 and cut[20, 30] < 0.2  # no height between the two surfaces
