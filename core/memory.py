@@ -3,6 +3,9 @@
 ``resource.getrusage(...).ru_maxrss`` exists only on POSIX and counts kilobytes on Linux but bytes
 on macOS; Windows has no ``resource`` module at all, its peak working set comes from
 ``GetProcessMemoryInfo`` (psapi). :func:`peak_rss_mb` hides the three.
+
+:func:`release_freed_memory` hands memory that the process has freed back to the system between
+the stages of a long run (glibc keeps it otherwise; elsewhere it does nothing).
 """
 
 from __future__ import annotations
@@ -49,3 +52,39 @@ def _windows_peak() -> float | None:
         return c.PeakWorkingSetSize / (1024.0 * 1024.0)
     except (OSError, AttributeError, ImportError):
         return None
+
+
+def release_freed_memory() -> None:
+    """Collect garbage and, with glibc (Linux), return the freed heap pages to the system.
+
+    glibc keeps what a stage frees in its arenas: after the orientation of 105 photos the process
+    held 752 MB, 239 MB after ``malloc_trim(0)``. The next stage's arrays then came on top of
+    that, and the pipeline's peak was the orientation's retained memory plus the dense matching's
+    (406 photos: 2.8 GB after the orientation, 4.2 GB peak in OSGM with a 1 GiB chunk). Called
+    between the stages of :func:`~truortho.core.workflow.run_workflow`. No-op on Windows, macOS and
+    C libraries without ``malloc_trim``.
+    """
+    import gc
+
+    gc.collect()
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6")
+        libc.malloc_trim(0)
+    except (OSError, AttributeError):
+        return
+
+
+def current_rss_mb() -> float | None:
+    """Resident memory of this process now, MiB (Linux ``/proc``); None elsewhere."""
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmRSS:"):
+                    return float(line.split()[1]) / 1024.0
+    except OSError:
+        return None
+    return None

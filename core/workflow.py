@@ -190,6 +190,7 @@ def run_workflow(
 
 def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) -> WorkflowResult:
     """:func:`run_workflow` after its checks, on ``executor`` (closed by the caller)."""
+    from .memory import release_freed_memory
     from .orientation import Orientation
     from .ortho.pipeline import true_ortho
     from .osgm import OsgmOutputs, run_osgm
@@ -235,6 +236,7 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
         stages.stop(f"{len(orientation.images)} of {len(images)} images oriented")
     steps[0].update(1.0, "orientation done")
     check(progress)
+    release_freed_memory()  # what the stage freed, back to the system before the next one
 
     # 2. OSGM
     stages.start("dense matching (OSGM)")
@@ -245,6 +247,7 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
         progress=steps[1], executor=executor,
     )  # fmt: skip
     stages.stop(osgm.summary())
+    release_freed_memory()  # what the stage freed, back to the system before the next one
     res = osgm.stats["resolution"]
 
     # 3. DSM filter
@@ -254,12 +257,15 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
         paths["dsm_raw"], paths["dsm"], paths["confidence"], fcfg, progress=steps[2], executor=executor
     )
     stages.stop(fstats.summary())
+    release_freed_memory()  # what the stage freed, back to the system before the next one
 
     # 4. mesh
     stages.start("mesh")
     mres = mesh_from_dsm(paths["dsm"], cfg.mesh or DsmMeshConfig(), paths["orthoimage"], progress=steps[3])
     write_mesh(paths["mesh"], mres.mesh)
     stages.stop(f"{len(mres.mesh.vertices)} vertices, {len(mres.mesh.faces)} faces")
+    del mres  # written: the mesh is not needed by the true ortho
+    release_freed_memory()  # what the stage freed, back to the system before the next one
 
     # 5. true orthophoto
     stages.start("true orthophoto")
@@ -272,6 +278,7 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
     write_seamlines(paths["seamlines"], tres.seamlines, tres.grid.crs)
     st = tres.stats
     stages.stop(f"coverage {100 * st['coverage']:.2f} %, {st['cells_occluded']} cells seen by no image")
+    release_freed_memory()  # what the stage freed, back to the system before the next one
 
     # 6. report
     stages.start("report")

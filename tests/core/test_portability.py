@@ -84,3 +84,37 @@ def test_peak_memory_windows_without_psapi(monkeypatch):
     monkeypatch.setattr(sys, "platform", "win32")
     monkeypatch.setitem(sys.modules, "resource", _FakeResource(1))  # must not be read
     assert memory.peak_rss_mb() is None  # this Linux ctypes has no windll
+
+
+def test_freed_memory_goes_back_to_the_system_between_stages(monkeypatch):
+    """glibc keeps freed heap memory in its arenas: a stage's freed arrays stayed resident and the
+    next stage's came on top (the 406-photo pipeline peaked at 4.6 GB). ``release_freed_memory``
+    returns them; elsewhere it does nothing and raises nothing."""
+    import platform
+
+    import pytest
+
+    from truortho.core import memory
+
+    if not sys.platform.startswith("linux") or platform.libc_ver()[0] != "glibc":
+        pytest.skip("malloc_trim is glibc's")
+    code = textwrap.dedent(
+        """
+        from truortho.core.memory import current_rss_mb, release_freed_memory
+        blocks = [bytearray(100_000) for _ in range(3000)]  # 300 MB in heap-sized pieces
+        for b in blocks:
+            b[::4096] = b"x" * len(b[::4096])  # touched: resident
+        pin = blocks[-1]  # the heap's top stays in use, so free() alone cannot shrink it
+        del blocks[:-1]
+        before = current_rss_mb()
+        release_freed_memory()
+        after = current_rss_mb()
+        print(before, after)
+        """
+    )
+    p = subprocess.run([sys.executable, "-P", "-c", code], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr[-2000:]
+    before, after = map(float, p.stdout.split())
+    assert before - after > 150.0, (before, after)
+    monkeypatch.setattr(sys, "platform", "win32")
+    assert memory.release_freed_memory() is None
