@@ -112,6 +112,10 @@ class _Stages:
         self._name, self._t = name, time.perf_counter()
 
     def stop(self, note: str = "") -> None:
+        """Record the stage, then hand what it freed back to the system before the next one
+        (:func:`~.memory.release_freed_memory`: otherwise the next stage's arrays come on top)."""
+        from .memory import release_freed_memory
+
         peak = peak_rss_mb()
         self.rows.append(
             [
@@ -121,6 +125,7 @@ class _Stages:
                 note,
             ]
         )
+        release_freed_memory()
 
 
 def _paths(folder: Path) -> dict[str, str]:
@@ -190,7 +195,6 @@ def run_workflow(
 
 def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) -> WorkflowResult:
     """:func:`run_workflow` after its checks, on ``executor`` (closed by the caller)."""
-    from .memory import release_freed_memory
     from .orientation import Orientation
     from .ortho.pipeline import true_ortho
     from .osgm import OsgmOutputs, run_osgm
@@ -236,7 +240,6 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
         stages.stop(f"{len(orientation.images)} of {len(images)} images oriented")
     steps[0].update(1.0, "orientation done")
     check(progress)
-    release_freed_memory()  # what the stage freed, back to the system before the next one
 
     # 2. OSGM
     stages.start("dense matching (OSGM)")
@@ -247,7 +250,6 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
         progress=steps[1], executor=executor,
     )  # fmt: skip
     stages.stop(osgm.summary())
-    release_freed_memory()  # what the stage freed, back to the system before the next one
     res = osgm.stats["resolution"]
 
     # 3. DSM filter
@@ -257,15 +259,14 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
         paths["dsm_raw"], paths["dsm"], paths["confidence"], fcfg, progress=steps[2], executor=executor
     )
     stages.stop(fstats.summary())
-    release_freed_memory()  # what the stage freed, back to the system before the next one
 
     # 4. mesh
     stages.start("mesh")
     mres = mesh_from_dsm(paths["dsm"], cfg.mesh or DsmMeshConfig(), paths["orthoimage"], progress=steps[3])
     write_mesh(paths["mesh"], mres.mesh)
-    stages.stop(f"{len(mres.mesh.vertices)} vertices, {len(mres.mesh.faces)} faces")
-    del mres  # written: the mesh is not needed by the true ortho
-    release_freed_memory()  # what the stage freed, back to the system before the next one
+    note = f"{len(mres.mesh.vertices)} vertices, {len(mres.mesh.faces)} faces"
+    del mres  # written: the true ortho does not need the mesh, and its memory is released below
+    stages.stop(note)
 
     # 5. true orthophoto
     stages.start("true orthophoto")
@@ -278,7 +279,6 @@ def _run(images, output_folder, gcps, crs, cfg, ocfg, tcfg, executor, progress) 
     write_seamlines(paths["seamlines"], tres.seamlines, tres.grid.crs)
     st = tres.stats
     stages.stop(f"coverage {100 * st['coverage']:.2f} %, {st['cells_occluded']} cells seen by no image")
-    release_freed_memory()  # what the stage freed, back to the system before the next one
 
     # 6. report
     stages.start("report")

@@ -297,12 +297,15 @@ SEAM_TOLERANCE = 2.0
 class _LevelTasks(Sequence):
     """The tile tasks of one level, built when the executor asks for them (bounded memory)."""
 
-    def __init__(self, tiles, g: RasterGrid, lv: int, plan: LevelPlan, params, cfg, prev_z, prev_filled, zsw):
+    def __init__(
+        self, tiles, g: RasterGrid, lv: int, plan: LevelPlan, params, cfg, prev_z, prev_filled, zsw,
+        blend: int,
+    ):  # fmt: skip
         self.tiles, self.g, self.lv, self.plan = tiles, g, lv, plan
         self.params = plan.level_params(params, lv)
         self.cfg, self.prev_z, self.prev_filled, self.zsw = cfg, prev_z, prev_filled, zsw
         self.max_cells_levels = 0
-        self.blend = 0  # cells beyond the core each task returns for the seams (assemble_tiles)
+        self.blend = blend  # cells beyond the core each task returns for the seams (assemble_tiles)
 
     def __len__(self) -> int:
         return len(self.tiles)
@@ -392,8 +395,9 @@ def _match_system(
         ov = max(16, ts // 8)
         side = ts + 2 * ov  # outer tile side, for the memory a task asks of the scheduler
         tiles = g.tiles(ts, ov)
-        tasks = _LevelTasks(tiles, g, lv, plan, params, cfg, prev_z, prev_filled, z_surface_windows)
-        tasks.blend = min(SEAM_BLEND, ov)
+        tasks = _LevelTasks(
+            tiles, g, lv, plan, params, cfg, prev_z, prev_filled, z_surface_windows, min(SEAM_BLEND, ov)
+        )
         sub = SubProgress(progress, done_cells / total, (done_cells + g.rows * g.cols) / total)
         try:
             results = executor.map_tiles(

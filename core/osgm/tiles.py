@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import InputError
 from ..parallel import Digest, ProcessLRU, current_cancel, file_identity, tune_worker_malloc
 from .matching import TileParams, View, match_tile
 from .views import ImagePyramid
@@ -99,11 +100,6 @@ class TileTask:
     gap_hi: np.ndarray | None = None
     blend: int = 0  # cells beyond the core returned for blending the seams (blend_window)
 
-    def inner(self) -> tuple[slice, slice]:
-        r = self.core[0] - self.outer[0]
-        c = self.core[1] - self.outer[1]
-        return slice(r, r + self.core[2]), slice(c, c + self.core[3])
-
     def returned(self) -> tuple[slice, slice]:
         """Slices (in the outer window) of what the task returns: its blend window."""
         r0, c0, nr, nc = blend_window(self.core, self.outer, self.blend)
@@ -163,6 +159,10 @@ def assemble_tiles(shape, tiles, results, blend: int, tol: float) -> tuple[np.nd
     differ slightly at a seam (on copr at 0.05 m about twice the cell-to-cell difference): cut hard,
     the seams showed as straight lines on the tile grid in a hillshade.
     """
+    if isinstance(blend, bool) or not isinstance(blend, int | np.integer) or blend < 0:
+        raise InputError(f"assemble_tiles: blend must be a number of cells >= 0, got {blend!r}")
+    if not (np.isfinite(tol) and tol >= 0):
+        raise InputError(f"assemble_tiles: tol must be a finite height >= 0, got {tol!r}")
     z = np.full(shape, np.nan, np.float32)
     conf = np.full(shape, np.nan, np.float32)
     if blend > 0:
@@ -173,6 +173,11 @@ def assemble_tiles(shape, tiles, results, blend: int, tol: float) -> tuple[np.nd
         count = np.zeros(shape, np.uint8)  # tiles that matched the cell
     for tile, (zt, ct) in zip(tiles, results, strict=True):
         r0, c0, nr, nc = blend_window(tile.core, tile.outer, blend)
+        if zt.shape != (nr, nc) or ct.shape != (nr, nc):
+            raise InputError(
+                f"assemble_tiles: tile {tile.index} returned heights {zt.shape} and confidences "
+                f"{ct.shape}, expected its blend window {(nr, nc)} (core {tile.core}, blend {blend})"
+            )
         a, b = tile.core[0] - r0, tile.core[1] - c0
         core = tile.core_slices
         z[core] = zt[a : a + tile.core[2], b : b + tile.core[3]]
@@ -182,12 +187,12 @@ def assemble_tiles(shape, tiles, results, blend: int, tol: float) -> tuple[np.nd
             wr = _ramp(r0, nr, tile.core[0], tile.core[2], blend)
             w = np.outer(wr, _ramp(c0, nc, tile.core[1], tile.core[3], blend)).astype(np.float32)
             ok = np.isfinite(zt)
-            w = np.where(ok, w, 0.0).astype(np.float32)
+            w[~ok] = 0.0
             sw[win] += w
             count[win] += ok
-            swz[win] += w * np.where(ok, zt, 0.0)
-            zmin[win] = np.minimum(zmin[win], np.where(ok, zt, np.inf))
-            zmax[win] = np.maximum(zmax[win], np.where(ok, zt, -np.inf))
+            swz[win] += w * np.nan_to_num(zt)
+            np.fmin(zmin[win], zt, out=zmin[win])  # fmin/fmax skip NaN
+            np.fmax(zmax[win], zt, out=zmax[win])
     if blend > 0:
         mix = np.isfinite(z) & (count > 1) & (sw > 0) & (zmax - zmin <= tol)
         z[mix] = (swz[mix] / sw[mix]).astype(np.float32)

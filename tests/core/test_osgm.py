@@ -634,3 +634,19 @@ def test_tile_seams_are_blended_where_the_tiles_agree_and_cut_where_they_do_not(
         k = 0 if c < 30 else 1
         assert cut[20, c] == pytest.approx(base[20, c] + offset[k] + wall[k][20, c], abs=1e-6)
     assert cut[20, 29] > 4.9 and cut[20, 30] < 0.2  # no height between the two surfaces
+
+
+def test_assemble_tiles_rejects_bad_input():
+    from truortho.core.osgm.tiles import assemble_tiles
+
+    grid = RasterGrid(0.0, 30.0, 1.0, 30, 60, "EPSG:32633")
+    tiles = grid.tiles(30, 8)
+    ok = [(np.zeros((30, 36), np.float32), np.zeros((30, 36), np.float32)),
+          (np.zeros((30, 36), np.float32), np.zeros((30, 36), np.float32))]  # fmt: skip
+    assemble_tiles(grid.shape, tiles, ok, 6, 0.2)
+    with pytest.raises(InputError, match="blend"):
+        assemble_tiles(grid.shape, tiles, ok, -1, 0.2)
+    with pytest.raises(InputError, match="tol"):
+        assemble_tiles(grid.shape, tiles, ok, 6, float("nan"))
+    with pytest.raises(InputError, match=r"tile \(0, 1\) returned heights \(30, 30\)"):
+        assemble_tiles(grid.shape, tiles, [ok[0], (np.zeros((30, 30), np.float32),) * 2], 6, 0.2)
