@@ -8,7 +8,7 @@ import pytest
 from truortho.core.errors import CRSError, InputError
 from truortho.core.formats.gcplist import read_gcp_list
 from truortho.core.orientation import GCP
-from truortho.core.sfm.pipeline import OrientConfig, orient_images
+from truortho.core.sfm.pipeline import OrientConfig, orient_images, stage_weights
 from truortho.core.synthetic import SceneConfig, make_scene
 
 
@@ -23,6 +23,28 @@ def synthetic_block(tmp_path_factory):
     folder = tmp_path_factory.mktemp("block")
     scene.write(folder)
     return scene, folder
+
+
+class _Recorder:
+    def __init__(self, fractions):
+        self.fractions = fractions
+
+    def update(self, fraction, message=None):
+        self.fractions.append(float(fraction))
+
+    def cancelled(self):
+        return False
+
+
+def test_stage_weights_follow_the_block():
+    # the 406-photo scale block: features 4.5 min, matching 6,915 pairs in 19 min, the rest 4 min
+    w = np.array(stage_weights(406, 6915))
+    share = w / w.sum()
+    assert share[1] == pytest.approx(19 / 27.5, abs=0.05)
+    assert share[0] == pytest.approx(4.5 / 27.5, abs=0.05)
+    # more pairs per image: matching takes more of the bar; a pair-free block still progresses
+    assert (lambda v: v[1] / v.sum())(np.array(stage_weights(40, 780))) > share[1]
+    assert all(x > 0 for x in stage_weights(1, 0))
 
 
 def test_orientation_accuracy_with_gcps(synthetic_block, tmp_path):
@@ -40,13 +62,17 @@ def test_orientation_accuracy_with_gcps(synthetic_block, tmp_path):
     gcps.append(GCP("lonely", gcps[0].xyz + 5.0, "gcp"))
     check = next(g for g in gcps if g.role == "check")
     check.observations.append(("not_in_block.png", 10.0, 20.0))
+    fractions: list[float] = []
     run = orient_images(
         paths + [str(folder / "flight_log.txt")],
         gcps=gcps,
         crs=crs,
         config=OrientConfig(working_size=640),
         work_dir=tmp_path,
+        progress=_Recorder(fractions),
     )
+    # the progress only moves forward, through every stage, to the end
+    assert fractions and np.all(np.diff(fractions) >= -1e-9) and fractions[-1] == pytest.approx(1.0)
     o = run.orientation
     rep = run.report.data
     print("summary", run.report.summary)
