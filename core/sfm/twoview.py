@@ -28,6 +28,7 @@ of image 2 and ``t`` its translation (unit length), ``C2 = -R.T @ t``.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -179,8 +180,33 @@ def _sampson(E, x1, x2):
     return num / np.sqrt(np.maximum(den, 1e-300))
 
 
+def _rodrigues(w) -> np.ndarray:
+    """Rotation matrix of the rotation vector ``w`` (radians)."""
+    th = float(np.linalg.norm(w))
+    if th < 1e-12:
+        return np.eye(3) + _skew(w)
+    k = _skew(np.asarray(w, float) / th)
+    return np.eye(3) + math.sin(th) * k + (1.0 - math.cos(th)) * (k @ k)
+
+
+def _huber_cost(r: np.ndarray, s: float) -> float:
+    a = np.abs(r)
+    return float(np.sum(np.where(a <= s, 0.5 * r * r, s * a - 0.5 * s * s)))
+
+
+#: Levenberg-Marquardt iterations of :func:`refine_pose`, and its stop: the relative decrease of the
+#: robust cost below which the pose has converged (SciPy's default ftol).
+REFINE_ITERATIONS = 30
+REFINE_TOLERANCE = 1e-8
+
+
 def refine_pose(R, t, n1, n2, loss_scale: float):
     """Refine a relative pose on inlier correspondences (Sampson distance, Huber loss).
+
+    Levenberg-Marquardt on iteratively reweighted least squares (Huber weights), five
+    parameters: a rotation increment and a step of the unit baseline in its tangent plane,
+    forward-difference Jacobian, all points at once. It replaced SciPy's ``least_squares``
+    (8-25 ms per call, three calls per image pair), with the same minimum.
 
     Parameters
     ----------
@@ -195,10 +221,7 @@ def refine_pose(R, t, n1, n2, loss_scale: float):
     -------
     R, t : refined pose (t unit length); the input when the refinement fails.
     """
-    import cv2
-    from scipy.optimize import least_squares
-
-    if len(n1) < 6:
+    if len(n1) < 6 or not loss_scale > 0:
         return R, t
     x1 = np.column_stack([n1, np.ones(len(n1))])
     x2 = np.column_stack([n2, np.ones(len(n2))])
@@ -208,23 +231,57 @@ def refine_pose(R, t, n1, n2, loss_scale: float):
     b1 = np.cross(t0, a)
     b1 /= np.linalg.norm(b1)
     b2 = np.cross(t0, b1)
+    s = float(loss_scale)
 
     def pose(p):
-        dR, _ = cv2.Rodrigues(p[:3])
         tt = t0 + p[3] * b1 + p[4] * b2
-        return dR @ R, tt / np.linalg.norm(tt)
+        return _rodrigues(p[:3]) @ R, tt / np.linalg.norm(tt)
 
-    def fun(p):
+    def residuals(p):
         Rp, tp = pose(p)
         return _sampson(_skew(tp) @ Rp, x1, x2)
 
-    try:
-        sol = least_squares(fun, np.zeros(5), loss="huber", f_scale=loss_scale, x_scale=1e-3, max_nfev=50)
-    except (ValueError, np.linalg.LinAlgError):
+    p = np.zeros(5)
+    r = residuals(p)
+    cost = _huber_cost(r, s)
+    if not np.isfinite(cost):
         return R, t
-    if not np.all(np.isfinite(sol.x)):
+    lam = 1e-3
+    h = 1e-7
+    J = np.empty((len(r), 5))
+    for _ in range(REFINE_ITERATIONS):
+        for k in range(5):
+            q = p.copy()
+            q[k] += h
+            J[:, k] = (residuals(q) - r) / h
+        ar = np.abs(r)
+        w = np.where(ar <= s, 1.0, s / np.maximum(ar, 1e-300))
+        A = J.T @ (J * w[:, None])
+        g = J.T @ (w * r)
+        d = np.diag(A).copy() + 1e-12 * (np.trace(A) + 1e-300)
+        improved = False
+        while lam < 1e8:
+            try:
+                dp = np.linalg.solve(A + lam * np.diag(d), -g)
+            except np.linalg.LinAlgError:
+                return R, t
+            r_new = residuals(p + dp)
+            c_new = _huber_cost(r_new, s)
+            if np.isfinite(c_new) and c_new < cost:
+                improved = True
+                break
+            lam *= 10.0
+        if not improved:
+            break
+        p, r = p + dp, r_new
+        decrease = cost - c_new
+        cost = c_new
+        lam = max(lam * 0.1, 1e-9)
+        if decrease <= REFINE_TOLERANCE * cost:
+            break
+    if not np.all(np.isfinite(p)):
         return R, t
-    return pose(sol.x)
+    return pose(p)
 
 
 def _in_front(R, t, n1, n2) -> np.ndarray:
