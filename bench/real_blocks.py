@@ -17,7 +17,10 @@ check points named below stay out of the adjustment). On the products (:func:`me
 * **roughness**: the median RMS residual of a plane fitted to 2 m x 2 m windows of the filtered DSM
   whose slope is under 10 degrees (flat ground: noise, streaks and pits raise it);
 * **streak index** of the filtered DSM (:func:`truortho.core.surface.quality.streak_index`): near 1
-  on natural terrain;
+  on isotropic terrain, but also high on terrain that is anisotropic in its own right (dune ripples);
+* **grid streak index** (:func:`truortho.core.surface.quality.grid_streak_index`): the same power
+  along the processing grid's axes and diagonals against the other directions, near 1 unless the
+  processing (SGM paths, tiles, height steps) left artefacts on its own axes;
 * **empty share** of the true ortho's frame (the cells with no colour) and its isolated empty
   cells (no colour, all 8 neighbours coloured: speckle), and the cells flagged in OCCLUSION;
 * the wall time and the peak resident memory of the pipeline's process, and a picture per block
@@ -163,7 +166,7 @@ def measures(products: str) -> dict:
 
     from truortho.core.orientation import as_orientation
     from truortho.core.rasterio_io import read_raster
-    from truortho.core.surface.quality import streak_index
+    from truortho.core.surface.quality import grid_streak_index, streak_index
 
     o = as_orientation(os.path.join(products, "orientation.json"))
     dsm, grid, _ = read_raster(os.path.join(products, "dsm.tif"))
@@ -189,6 +192,7 @@ def measures(products: str) -> dict:
         "holes_over_1m2": big,
         "roughness_m": roughness(dsm, grid.res),
         "streak_index": streak_index(dsm),
+        "grid_streak_index": grid_streak_index(dsm),
         "ortho_empty": float(empty.mean()),
         "ortho_empty_seen2": float(empty[oseen2].mean()) if oseen2.any() else 0.0,
         "ortho_speckle": int((empty & (neighbours == 8)).sum()),
@@ -232,14 +236,16 @@ def main(argv=None) -> int:
         f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {os.cpu_count()} cores",
         "",
         "| block | cells (res m) | area seen by >= 2 photos m^2 | completeness | raw holes | holes >= 1 m^2 "
-        "| roughness m | streak index | ortho empty (frame / seen by 2) | speckle | occluded | s | peak MB |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| roughness m | streak index | grid streak index | ortho empty (frame / seen by 2) | speckle "
+        "| occluded | s | peak MB |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for r in rows:
         lines.append(
             f"| {r['block']} | {r['cells']} ({r['resolution']:.3f}) | {r['area_seen2_m2']:.0f} | "
             f"{100 * r['completeness']:.1f} % | {100 * r['raw_holes']:.1f} % | {r['holes_over_1m2']} | "
-            f"{r['roughness_m']:.3f} | {r['streak_index']:.2f} | {100 * r['ortho_empty']:.1f} / "
+            f"{r['roughness_m']:.3f} | {r['streak_index']:.2f} | {r['grid_streak_index']:.2f} | "
+            f"{100 * r['ortho_empty']:.1f} / "
             f"{100 * r['ortho_empty_seen2']:.1f} % | {r['ortho_speckle']} | {r['occlusion_flagged']} | "
             f"{r['seconds']:.0f} | {r.get('peak_mb', math.nan):.0f} |"
         )

@@ -1,4 +1,4 @@
-"""The DSM streak index (:func:`truortho.core.surface.quality.streak_index`)."""
+"""The DSM streak indices (:mod:`truortho.core.surface.quality`)."""
 
 from __future__ import annotations
 
@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from truortho.core.errors import InputError
-from truortho.core.surface.quality import streak_index
+from truortho.core.surface.quality import grid_streak_index, streak_index
 
 
 def _red_noise(rng, n: int, beta: float) -> np.ndarray:
@@ -74,3 +74,41 @@ def test_plane_and_bad_input():
         streak_index(np.zeros((64, 64)), min_wavelength=1.0)
     with pytest.raises(InputError):
         streak_index(np.zeros((64, 64)), sectors=1)
+
+
+def _ripples(rng, n: int, angle_deg: float) -> np.ndarray:
+    """Anisotropic natural relief: red noise stretched along ``angle_deg`` (dune ripples, furrows)."""
+    fy = np.fft.fftfreq(n)[:, None]
+    fx = np.fft.fftfreq(n)[None, :]
+    a = np.radians(angle_deg)
+    along = fx * np.cos(a) + fy * np.sin(a)
+    across = -fx * np.sin(a) + fy * np.cos(a)
+    f = np.hypot(4.0 * along, across)  # crests 4x longer than their spacing
+    f[0, 0] = 1.0
+    return np.real(np.fft.ifft2(np.fft.fft2(rng.normal(size=(n, n))) / f**1.5))
+
+
+def test_grid_streak_index_tells_processing_artefacts_from_anisotropic_terrain():
+    rng = np.random.default_rng(5)
+    yy, xx = np.mgrid[0:256, 0:256]
+    for _ in range(2):
+        assert 0.8 < grid_streak_index(rng.normal(size=(256, 256))) < 1.2
+    # anisotropic relief off the grid's directions: streak_index calls it streaky, this does not
+    for angle in (20.0, 70.0, 115.0, 155.0):
+        r = _ripples(rng, 256, angle)
+        assert streak_index(r) > 3
+        assert grid_streak_index(r) < 1.3
+    # artefacts on the grid: terraces along an axis, SGM-like lines on a diagonal, on natural relief
+    relief = _red_noise(rng, 256, 1.5)
+    relief /= relief.std()
+    assert grid_streak_index(np.floor(0.3 * xx) + 0.05 * rng.normal(size=xx.shape)) > 5
+    assert grid_streak_index(relief + 0.5 * np.sin(2 * np.pi * (xx + yy) / 8.0)) > 3
+    assert grid_streak_index(relief) < 1.3
+
+
+def test_grid_streak_index_bad_input():
+    assert grid_streak_index(np.full((32, 32), 2.0)) == 1.0
+    assert np.isnan(grid_streak_index(np.full((32, 32), np.nan)))
+    for bad in ({"half_width": 0.0}, {"half_width": 30.0}, {"min_wavelength": 1.0}):
+        with pytest.raises(InputError):
+            grid_streak_index(np.zeros((32, 32)), **bad)
