@@ -40,8 +40,13 @@ from ..grid import RasterGrid
 from ..jit import njit
 from ..sgm.selection import _finite_window
 
-#: Z steps the coarsest level may need for the whole range.
-COARSE_LEVELS = 64
+#: Z steps the coarsest level may need for the whole range. It sets the coarsest cell: about
+#: ``range / COARSE_LEVELS`` to twice that, so a tall building makes the small ones few cells wide
+#: there. With 64, battery scene 3 (a 48 m tower; 1.86 m cells) matched three low-texture roofs of
+#: 6-16 m at the ground: their 5 x 5 windows held more ground than roof, and the finer levels, which
+#: search a band around the coarser result, could not climb back 5-16 m. With 128 (0.93 m cells)
+#: they were found, and scene 3's edge3 rose from 74.0 to 83.9 %, flat3 from 95.8 to 98.4 %.
+COARSE_LEVELS = 128
 #: Smallest side of the coarsest grid, cells.
 MIN_COARSE_CELLS = 16
 #: Coarse steps added above and below the coarse neighbourhood's range (and around each coarse
