@@ -20,7 +20,13 @@ from truortho.core.errors import CancelledError, InputError, MissingFileError  #
 from truortho.core.geometry import project_points  # noqa: E402
 from truortho.core.grid import RasterGrid  # noqa: E402
 from truortho.core.osgm import OsgmConfig, OsgmOutputs, plan_levels, reference_systems, run_osgm  # noqa: E402
-from truortho.core.osgm.levels import MARGIN_STEPS, MAX_BAND, refine_bands, refine_windows  # noqa: E402
+from truortho.core.osgm.levels import (  # noqa: E402
+    COARSE_LEVELS,
+    MARGIN_STEPS,
+    MAX_BAND,
+    refine_bands,
+    refine_windows,
+)
 from truortho.core.osgm.views import monotonic_radius2, plane_map  # noqa: E402
 from truortho.core.progress import CallbackProgress  # noqa: E402
 from truortho.core.rasterio_io import read_raster  # noqa: E402
@@ -84,7 +90,7 @@ def test_level_plan_and_refined_windows():
     plan = plan_levels(-5.0, 55.0, 0.25, grid)
     top = plan.levels[0]
     assert plan.levels == list(range(top, -1, -1)) and top >= 2
-    assert plan.count(top) <= 64 + 1 and plan.z_top >= 55.0
+    assert plan.count(top) <= COARSE_LEVELS + 1 and plan.z_top >= 55.0
     # a coarse result with a 10 m step: cells near it search both sides, far cells a narrow band
     coarse = np.zeros(plan.grid(grid, 1).shape, np.float32)
     coarse[:, 100:] = 10.0
