@@ -231,7 +231,12 @@ def main(argv=None) -> int:
     ]
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()  # fmt: skip
-    cmd = "python -P bench/real_blocks.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    shown = list(argv if argv is not None else sys.argv[1:])
+    if "--keep" in shown:  # a local folder, not part of what is measured
+        k = shown.index("--keep")
+        del shown[k : k + 2]
+    shown = [a for a in shown if not a.startswith("--keep=")]
+    cmd = "python -P bench/real_blocks.py " + " ".join(shown)
     lines = [
         f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {os.cpu_count()} cores",
         "",
