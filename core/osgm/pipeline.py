@@ -89,6 +89,10 @@ class OsgmConfig:
         Images matched per tile (best coverage, then most nadir).
     max_view_angle : float
         Largest angle (degrees) between the ray to a tile and the system's Z axis.
+    rim_view_angle : float
+        Views steeper than ``max_view_angle`` up to this angle are taken only for the tiles
+        where the others leave a part with fewer than two views (the rim of a block, which
+        only obliques see twice); 0 = never.
     oblique : {"none", "auto"}
         ``"auto"``: additional reference systems for groups of oblique images.
     oblique_group_angle : float
@@ -147,6 +151,7 @@ class OsgmConfig:
     adaptive_p2: bool = True
     max_images: int = 12
     max_view_angle: float = 50.0
+    rim_view_angle: float = 65.0
     oblique: str = "none"
     oblique_group_angle: float = 35.0
     tile_size: int = 256
@@ -202,6 +207,12 @@ class OsgmConfig:
             raise InputError(f"median: expected an odd size >= 1, got {self.median!r}")
         if not 0 < float(self.max_view_angle) < 90:
             raise InputError(f"max_view_angle: expected degrees in (0, 90), got {self.max_view_angle!r}")
+        rim = float(self.rim_view_angle)
+        if rim != 0 and not float(self.max_view_angle) <= rim < 90:
+            raise InputError(
+                f"rim_view_angle: expected 0 (off) or degrees in [max_view_angle {self.max_view_angle}, 90), "
+                f"got {self.rim_view_angle!r}"
+            )
         if self.executor not in EXECUTORS:
             raise InputError(f"EXECUTOR: expected one of {', '.join(EXECUTORS)}, got {self.executor!r}")
         if self.workers is not None and int(self.workers) < 1:
@@ -225,6 +236,7 @@ class OsgmConfig:
             max_images=int(self.max_images),
             max_view_angle=float(self.max_view_angle),
             median=int(self.median),
+            rim_view_angle=float(self.rim_view_angle),
             edges=bool(self.refine_edges),
         )
 

@@ -591,6 +591,38 @@ def test_image_choice_keeps_two_views_where_the_candidates_give_them():
     assert len(_select(cand[:14], 12)) == 12
 
 
+def test_steep_views_only_where_the_near_ones_leave_points_short():
+    """The rim of a block that only obliques see twice: one near view there, and steep views
+    (beyond ``max_view_angle``) that see the rim or the interior. Only the steep views that bring
+    rim points to two views are taken; an interior the near views cover twice takes none, and a
+    steep view that cannot bring a point to two views is not kept."""
+    from truortho.core.osgm.matching import MIN_VIEWS, _rim_views, _select
+
+    n_pts = 17 * 17
+    rim = np.zeros(n_pts, bool)
+    rim[:34] = True  # the tile's first two lattice rows
+    near = [(~rim, 10.0 + k, 100.0, f"nadir{k}") for k in range(4)]
+    near.append((rim | (np.arange(n_pts) < 60), 30.0, 110.0, "edge"))  # the one near view of the rim
+    steep = [
+        (rim & (np.arange(n_pts) % 2 == 0), 58.0, 160.0, "oblique_rim_even"),
+        (rim.copy(), 55.0, 150.0, "oblique_rim"),
+        (~rim, 52.0, 140.0, "oblique_interior"),
+    ]
+    chosen = _select(near, 12)
+    rims = _rim_views(near, chosen, steep)
+    names = [v for _, _, v in rims]
+    assert names == ["oblique_rim"]  # the one that covers every rim point, the least steep of the rest
+    count = np.sum([c[0] for c in near + steep if c[3] in [v for _, _, v in chosen] + names], axis=0)
+    assert np.all(count >= MIN_VIEWS)
+    # near views that cover every point twice: no steep view
+    full = near[:4] + [(np.ones(n_pts, bool), 30.0 + k, 110.0, f"all{k}") for k in range(2)]
+    assert _rim_views(full, _select(full, 12), steep) == []
+    # a steep view that brings no point to two views is not kept (no near view at all on the rim)
+    lone = [(rim & (np.arange(n_pts) < 17), 58.0, 160.0, "lone")]
+    assert _rim_views(near[:4], _select(near[:4], 12), lone) == []
+    assert _rim_views(near, chosen, []) == []
+
+
 def test_tile_seams_are_blended_where_the_tiles_agree_and_cut_where_they_do_not():
     """Neighbouring tiles match with different images and borders: their heights differ slightly
     at a seam, which a hard cut shows as a straight line on the tile grid. Within the blend band
