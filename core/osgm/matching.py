@@ -128,17 +128,25 @@ def _select(cand, max_images: int):
         count += cand[best][0]
     # beyond the cap, only where the chosen images still leave a point with fewer than the two views
     # matching needs while the candidates give it two
+    chosen += _fill_short(cand, left, count, avail)
+    return [(cand[k][1], cand[k][2], cand[k][3]) for k in chosen]
+
+
+def _fill_short(cand, left: list[int], count: np.ndarray, target) -> list[int]:
+    """Greedily the candidates ``left`` that give most points short of ``target`` views a view
+    (ties: the smaller angle), until none is short or none helps; ``count`` is updated."""
+    taken = []
     while left:
-        short = count < avail
+        short = count < target
         if not short.any():
             break
         best = max(left, key=lambda k: (int(np.count_nonzero(short & cand[k][0])), -cand[k][1]))
         if not np.any(short & cand[best][0]):
             break
-        chosen.append(best)
+        taken.append(best)
         left.remove(best)
         count += cand[best][0]
-    return [(cand[k][1], cand[k][2], cand[k][3]) for k in chosen]
+    return taken
 
 
 def _rim_views(cand, near, steep):
@@ -160,18 +168,7 @@ def _rim_views(cand, near, steep):
         if id(v) in chosen:
             base += inside
     count = base.copy()
-    left = list(range(len(steep)))
-    taken = []
-    while left:
-        short = count < MIN_VIEWS
-        if not short.any():
-            break
-        best = max(left, key=lambda k: (int(np.count_nonzero(short & steep[k][0])), -steep[k][1]))
-        if not np.any(short & steep[best][0]):
-            break
-        left.remove(best)
-        count += steep[best][0]
-        taken.append(steep[best])
+    taken = [steep[k] for k in _fill_short(steep, list(range(len(steep))), count, MIN_VIEWS)]
     helped = (base < MIN_VIEWS) & (count >= MIN_VIEWS)
     return [(a, d, v) for inside, a, d, v in taken if np.any(inside & helped)]
 
