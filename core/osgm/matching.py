@@ -134,7 +134,8 @@ def _select(cand, max_images: int):
 
 def _fill_short(cand, left: list[int], count: np.ndarray, target) -> list[int]:
     """Greedily the candidates ``left`` that give most points short of ``target`` views a view
-    (ties: the smaller angle), until none is short or none helps; ``count`` is updated."""
+    (ties: the smaller angle), until none is short or none helps. Returns their indices; ``count``
+    gets their views and ``left`` loses them."""
     taken = []
     while left:
         short = count < target
@@ -197,7 +198,7 @@ def choose_images(
             continue
         (cand if angle <= params.max_view_angle else steep).append((inside, angle, dist, v))
     out = []
-    near = _select(cand, params.max_images) if cand else []
+    near = _select(cand, params.max_images)
     for angle, dist, v in near + _rim_views(cand, near, steep):
         depth = dist * max(v.axis_cos, 0.2)
         gsd = depth / v.camera.fx

@@ -367,8 +367,9 @@ def stage_weights(n_images: int, n_pairs: int) -> list[float]:
     """Progress weights of features, matching, tracks, reconstruction, datum and report."""
     c = STAGE_COSTS
     n = max(int(n_images), 1)
-    per_image = [c["features"], None, c["tracks"], c["reconstruction"], c["datum"], c["report"]]
-    return [c["pair"] * max(int(n_pairs), 1) if w is None else w * n for w in per_image]
+    pairs = max(int(n_pairs), 1)
+    per_image = [c[k] * n for k in ("tracks", "reconstruction", "datum", "report")]
+    return [c["features"] * n, c["pair"] * pairs, *per_image]
 
 
 def match_images(inputs: OrientInputs, cfg: OrientConfig, work_dir, sel, steps, times: dict) -> OrientMatches:

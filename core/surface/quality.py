@@ -199,10 +199,9 @@ def streak_index(
         return band
     p, theta = band
     s = np.minimum((theta / (180.0 / sectors)).astype(np.int64), sectors - 1)
-    z_shape = np.shape(dsm)
     count = np.bincount(s, minlength=sectors).astype(np.float64)
     if (count == 0).any():
-        raise InputError(f"dsm: {z_shape} is too small for {sectors} sectors in the wavelength band")
+        raise InputError(f"dsm: {np.shape(dsm)} is too small for {sectors} sectors in the wavelength band")
     mean = np.bincount(s, weights=p, minlength=sectors) / count
     top = float(mean.max())
     if top <= 1e-300:
