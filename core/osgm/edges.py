@@ -27,6 +27,13 @@ evidence that no straddling window mixes:
    the next ones (on battery windows 2 -> 6 passes: edge cells within 3 GSD 83.7 -> 85.1 %,
    66.9 -> 68.2 %, 60.8 -> 63.3 % with 4). After the first pass only the cells within
    :data:`AFFECT` of a cell that switched are decided again.
+6. **Holes**: a cell near a step that matching left empty (no clear minimum, or one rejected by
+   the uniqueness or median test: typically the foot of a wall or the rim of a roof) takes the
+   more photo-consistent side, with at least one pair of views on each side, and a confidence of
+   ``1 - own cost / other cost`` (the DSM filter's ``min_confidence`` drops near-ties). Any hole
+   counts as a wrong height, and the filter would fill it by interpolation across the step, half
+   way up the wall; on the battery (scenes 0, 2, 3, 4, 8, 9) the share of edge cells within 3 GSD
+   rose by 1.0 to 4.4 points (scene 2: 72.7 -> 77.1 %), completeness by 0.2 to 0.3.
 """
 
 from __future__ import annotations
@@ -158,14 +165,16 @@ def _consistency(samples: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, 
 
 
 def refine_edges(
-    z: np.ndarray, images, x0: float, y0: float, res: float, step: float, tol: float, cancelled=None
+    z: np.ndarray, images, x0: float, y0: float, res: float, step: float, tol: float, cancelled=None,
+    conf: np.ndarray | None = None,
 ) -> np.ndarray:
     """Heights ``z`` (rows, cols, local, NaN = none) with the sides of height steps re-decided.
 
     ``images``: the tile's :class:`~.matching.TileImage` list (their matching band windows);
     ``step``: the smallest height difference (m) that is a step; ``tol``: height tolerance of the
     visibility march (m); ``cancelled``: optional callable, checked between passes (a cancelled
-    refinement returns the heights of the passes done). See the module docstring.
+    refinement returns the heights of the passes done); ``conf``: optional confidence (rows, cols),
+    written in place at the holes filled. See the module docstring.
     """
     from scipy.ndimage import binary_dilation, maximum_filter, minimum_filter
 
@@ -176,6 +185,8 @@ def refine_edges(
                               ("tol", tol, tol >= 0, ">= 0")):  # fmt: skip
         if not (np.isfinite(v) and ok):
             raise InputError(f"refine_edges: {name} must be a finite number {want}, got {v!r}")
+    if conf is not None and np.shape(conf) != z.shape:
+        raise InputError(f"refine_edges: conf must have the heights' shape {z.shape}, got {np.shape(conf)}")
     if len(images) < 2 or not np.isfinite(z).any():
         return z
     stats = []
@@ -195,7 +206,7 @@ def refine_edges(
         zmax = maximum_filter(np.where(finite, z, -np.inf), 3)
         zmin = minimum_filter(np.where(finite, z, np.inf), 3)
         steps = finite & ((zmax - zmin) > step)
-        zone = binary_dilation(steps, iterations=REACH) & finite
+        zone = binary_dilation(steps, iterations=REACH)  # with the holes near a step
         if active is not None:
             zone &= active
         ri, ci = np.nonzero(zone)
@@ -232,21 +243,25 @@ def refine_edges(
                 mu, sd = stats[v]
                 samples[v] = ((_samples(img, P) - mu) / sd).reshape(n, 9)
             cost[k], npairs[k] = _consistency(samples, visible)
-        side = (z[ri, ci] > mid).astype(np.int64)  # 0 low, 1 high
-        other = 1 - side
+        hole = ~np.isfinite(z[ri, ci])
         idx = np.arange(n)
+        decidable = np.isfinite(mid) & (hi - lo > step) & (npairs[0] >= 1) & (npairs[1] >= 1)
+        # a hole takes the more photo-consistent side; a height switches only on clear evidence
+        side = np.where(hole, (cost[1] < cost[0]).astype(np.int64), (z[ri, ci] > mid).astype(np.int64))
+        other = 1 - side
         own_c, oth_c = cost[side, idx], cost[other, idx]
-        switch = (
-            np.isfinite(mid)
-            & (hi - lo > step)
-            & (npairs[other, idx] >= 1)
-            & (npairs[side, idx] >= 1)
-            & (oth_c < RATIO * own_c)
-        )
-        if not switch.any():
+        fill = hole & decidable
+        switch = ~hole & decidable & (oth_c < RATIO * own_c)
+        if not (switch.any() or fill.any()):
             break
         z[ri[switch], ci[switch]] = cand[other[switch], idx[switch]].astype(np.float32)
+        z[ri[fill], ci[fill]] = cand[side[fill], idx[fill]].astype(np.float32)
+        if conf is not None and fill.any():
+            # the margin between the sides: 0 for a tie, 1 for a side no worse than perfect
+            margin = 1.0 - own_c[fill] / np.maximum(oth_c[fill], 1e-12)
+            conf[ri[fill], ci[fill]] = np.clip(margin, 0.0, 1.0).astype(conf.dtype)
         moved = np.zeros(z.shape, np.uint8)
         moved[ri[switch], ci[switch]] = 1
+        moved[ri[fill], ci[fill]] = 1
         active = maximum_filter(moved, 2 * AFFECT + 1).astype(bool)
     return z

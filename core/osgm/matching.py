@@ -456,5 +456,5 @@ def match_tile(
     if params.edges:
         from .edges import refine_edges
 
-        z = refine_edges(z, images, x0, y0, res, max(1.0, 4.0 * dz), 2.0 * dz, cancelled)
+        z = refine_edges(z, images, x0, y0, res, max(1.0, 4.0 * dz), 2.0 * dz, cancelled, conf)
     return TileResult(z, conf.astype(np.float32), images, evaluated, nd)

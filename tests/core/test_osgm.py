@@ -477,12 +477,13 @@ def test_edge_refinement_undoes_fattening(tmp_path):
     )
     scene.write(tmp_path)
     res = scene.config.gsd
-    shares = {}
+    shares, dsms, confs = {}, {}, {}
     for refine in (False, True):
-        out = OsgmOutputs(dsm=tmp_path / f"dsm_{refine}.tif")
+        out = OsgmOutputs(dsm=tmp_path / f"dsm_{refine}.tif", confidence=tmp_path / f"conf_{refine}.tif")
         cfg = OsgmConfig(resolution=res, refine_edges=refine)
         run_osgm(scene.orientation, cfg, scene.extent_world(), out, tmp_path)
         dsm, grid, _ = read_raster(out.dsm)
+        dsms[refine], confs[refine] = dsm, read_raster(out.confidence)[0]
         truth, nvis = _truth_and_seen(scene, grid)
         low = (maximum_filter(truth, 7) - truth > 2.0) & (nvis >= 2)  # ground within 3 cells of a wall
         high = (truth - minimum_filter(truth, 7) > 2.0) & (nvis >= 2)
@@ -491,6 +492,15 @@ def test_edge_refinement_undoes_fattening(tmp_path):
     print(f"\nfattened / eroded share near walls: without {shares[False]}, with refinement {shares[True]}")
     assert shares[True][0] < 0.8 * shares[False][0]
     assert shares[True][1] < shares[False][1] + 0.05
+    # the holes next to walls take the side their views agree on, with a confidence
+    near = (low | high) & np.isfinite(truth)
+    filled = near & np.isnan(dsms[False]) & np.isfinite(dsms[True])
+    right = np.abs(dsms[True] - truth) <= 3 * res
+    print(f"holes near walls: {np.isnan(dsms[False])[near].mean():.3f} -> {np.isnan(dsms[True])[near].mean():.3f}; "
+          f"{filled.sum()} filled, {right[filled].mean():.3f} within 3 GSD")  # fmt: skip
+    assert filled.sum() >= 20
+    assert right[filled].mean() >= 0.7
+    assert np.isfinite(confs[True][filled]).all() and (confs[True][filled] >= 0).all()
 
 
 @pytest.mark.slow
