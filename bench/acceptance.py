@@ -300,6 +300,9 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
         "cells": grid.rows * grid.cols,
         "gsd": gsd,
         "seen2": float(seen2.mean()),
+        # base-to-height ratio of neighbouring nadir photos (the image height lies along the strip):
+        # a height error of e GSD is a parallax error of e * B/H pixels between them
+        "base_height": (1.0 - cfg.forward_overlap) * cfg.image_size[1] / cfg.focal_px,
     }
 
     zlo, zhi = float(np.nanmin(truth)) - 5.0, float(np.nanmax(truth)) + 5.0
@@ -310,6 +313,7 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     t_osgm = time.perf_counter() - t
     dsm, _, _ = read_raster(out.dsm)
     row["osgm"] = dsm_figures(dsm, truth, seen2, edge, gsd)
+    row["osgm"]["nmad_parallax_px"] = row["osgm"]["nmad_gsd"] * row["base_height"]
     row["osgm"]["streak_index"] = streak_index(dsm)
     row["truth_streak_index"] = streak_index(truth)
     row["osgm"]["seconds"] = t_osgm
@@ -456,6 +460,7 @@ def summary(rows: list[dict]) -> list[str]:
         "ortho_truth.ghosting_beyond_outline",
         "ortho_osgm.ghosting_beyond_outline",
         "ortho_conventional.ghosting_beyond_outline",
+        "osgm.nmad_parallax_px",
         "osgm_filtered.completeness",
         "osgm_filtered.nmad_gsd",
         "osgm_filtered.flat3",
@@ -483,7 +488,7 @@ def summary(rows: list[dict]) -> list[str]:
 
 def scene_table(rows: list[dict]) -> list[str]:
     head = (
-        "| # | imgs (obl) | OSGM compl | NMAD | flat3 | edge3 | s | SGBM compl | NMAD | flat3 | edge3 | s | "
+        "| # | imgs (obl) | B/H | OSGM compl | NMAD | flat3 | edge3 | s | SGBM compl | NMAD | flat3 | edge3 | s | "
         "ghost truth | conv | ghost OSGM | shift | dE | wrong fill | failed |"
     )
     lines = [head, "|" + "---|" * (head.count("|") - 1)]
@@ -499,7 +504,8 @@ def scene_table(rows: list[dict]) -> list[str]:
             else "- | - | - | - | -"
         )
         lines.append(
-            f"| {r['scene']} | {r['images']} ({r['obliques']}) | {100 * o['completeness']:.1f} | "
+            f"| {r['scene']} | {r['images']} ({r['obliques']}) | {r.get('base_height', float('nan')):.2f} | "
+            f"{100 * o['completeness']:.1f} | "
             f"{o['nmad_gsd']:.2f} | "
             f"{100 * o['flat3']:.1f} | {100 * o['edge3']:.1f} | {o['seconds']:.0f} | {sg} | "
             f"{100 * t['ghosting']:.2f} | {100 * c['ghosting']:.1f} | {100 * g['ghosting']:.2f} | "
@@ -515,8 +521,10 @@ def run_header(script: str, argv, detail: str = "") -> tuple[str, str, str]:
     cmd = f"python -P bench/{script} " + " ".join(argv if argv is not None else sys.argv[1:])
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()  # fmt: skip
+    # the times are only comparable between runs on an idle machine: say how loaded this one was
+    load = f", load average {os.getloadavg()[0]:.1f} at the end" if hasattr(os, "getloadavg") else ""
     head = (f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {platform.machine()} "
-            f"{os.cpu_count()} cores" + (f", {detail}" if detail else ""))  # fmt: skip
+            f"{os.cpu_count()} cores{load}" + (f", {detail}" if detail else ""))  # fmt: skip
     return cmd, commit, head
 
 
