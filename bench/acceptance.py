@@ -488,7 +488,8 @@ def summary(rows: list[dict]) -> list[str]:
 
 def scene_table(rows: list[dict]) -> list[str]:
     head = (
-        "| # | imgs (obl) | B/H | OSGM compl | NMAD | flat3 | edge3 | s | SGBM compl | NMAD | flat3 | edge3 | s | "
+        "| # | imgs (obl) | B/H | OSGM compl | NMAD | flat3 | edge3 | s | "
+        "SGBM compl | NMAD | flat3 | edge3 | s | "
         "ghost truth | conv | ghost OSGM | shift | dE | wrong fill | failed |"
     )
     lines = [head, "|" + "---|" * (head.count("|") - 1)]

@@ -496,7 +496,8 @@ def test_edge_refinement_undoes_fattening(tmp_path):
     near = (low | high) & np.isfinite(truth)
     filled = near & np.isnan(dsms[False]) & np.isfinite(dsms[True])
     right = np.abs(dsms[True] - truth) <= 3 * res
-    print(f"holes near walls: {np.isnan(dsms[False])[near].mean():.3f} -> {np.isnan(dsms[True])[near].mean():.3f}; "
+    holes = [np.isnan(dsms[k])[near].mean() for k in (False, True)]
+    print(f"holes near walls: {holes[0]:.3f} -> {holes[1]:.3f}; "
           f"{filled.sum()} filled, {right[filled].mean():.3f} within 3 GSD")  # fmt: skip
     assert filled.sum() >= 20
     assert right[filled].mean() >= 0.7
