@@ -237,8 +237,10 @@ def main(argv=None) -> int:
         del shown[k : k + 2]
     shown = [a for a in shown if not a.startswith("--keep=")]
     cmd = "python -P bench/real_blocks.py " + " ".join(shown)
+    # the s and peak columns are only comparable between runs on an idle machine
+    load = f", load average {os.getloadavg()[0]:.1f} at the end" if hasattr(os, "getloadavg") else ""
     lines = [
-        f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {os.cpu_count()} cores",
+        f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {os.cpu_count()} cores{load}",
         "",
         "| block | cells (res m) | area seen by >= 2 photos m^2 | completeness | raw holes | holes >= 1 m^2 "
         "| roughness m | streak index | grid streak index | ortho empty (frame / seen by 2) | speckle "
