@@ -110,6 +110,9 @@ class OsgmConfig:
         Re-decide the side of every cell near a height step on the finest
         level with occlusion-aware 3 x 3 photo-consistency (:mod:`.edges`):
         against the fattening of window matching at building outlines.
+    slope_max : int
+        Below the coarsest level, SGM follows the coarser level's slopes up to this many Z levels
+        per cell (:func:`~.matching.slope_trend`): slanted roofs are not flattened by P1; 0 = off.
     band : int, optional
         0-based band to match on; default the luminance.
     max_levels : int
@@ -160,6 +163,7 @@ class OsgmConfig:
     uniqueness: float = 0.99
     median: int = 3
     refine_edges: bool = True
+    slope_max: int = 2
     band: int | None = None
     max_levels: int = 5
     chunk_memory: int = 1 << 30
@@ -191,6 +195,10 @@ class OsgmConfig:
                 raise InputError(f"{name.upper()}: expected a positive number, got {v!r}")
         if self.z_min is not None and self.z_max is not None and not float(self.z_min) < float(self.z_max):
             raise InputError(f"Z_MIN ({self.z_min}) must be below Z_MAX ({self.z_max})")
+        sm = self.slope_max
+        if isinstance(sm, bool) or not isinstance(sm, int) or not 0 <= sm <= 16:
+            raise InputError(f"slope_max: expected an integer number of Z levels per cell in [0, 16], "
+                             f"got {self.slope_max!r}")  # fmt: skip
         p1 = DEFAULT_P1 if self.p1 is None else int(self.p1)
         p2 = DEFAULT_P2 if self.p2 is None else int(self.p2)
         if not (0 <= p1 < p2 <= P2_MAX):
@@ -238,6 +246,7 @@ class OsgmConfig:
             median=int(self.median),
             rim_view_angle=float(self.rim_view_angle),
             edges=bool(self.refine_edges),
+            slope_max=int(self.slope_max),
         )
 
 

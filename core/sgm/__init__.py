@@ -17,7 +17,7 @@ Cost units, the valid-sample rule and the integer bounds are documented in
 :mod:`.cost` and :mod:`.aggregation`.
 """
 
-from .aggregation import DEFAULT_P1, DEFAULT_P2, P2_MAX, adaptive_p2, aggregate
+from .aggregation import DEFAULT_P1, DEFAULT_P2, P2_MAX, TREND_NONE, adaptive_p2, aggregate
 from .cost import (
     COST_MAX,
     DEFAULT_MEASURE,
@@ -31,6 +31,7 @@ from .rectified import disparity_costs, match_rectified
 from .selection import DEFAULT_UNIQUENESS, median_filter, select, valid_cells
 
 __all__ = [
+    "TREND_NONE",
     "COST_MAX",
     "DEFAULT_MEASURE",
     "DEFAULT_MIN_VALID",

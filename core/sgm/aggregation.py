@@ -284,7 +284,7 @@ def _p2_step(p2m, guide, edge, p1, r, c, rq, cq):
 
 
 @njit
-def _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, down, i0, i1, lf, mbuf, touch):
+def _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, down, i0, i1, lf, mbuf, touch, tr, kmax):
     """Steps ``i0 <= i < i1`` of one vertical sweep, all its paths fused.
 
     Down (``down``): rows ``i`` top to bottom, columns left to right, with the
@@ -334,7 +334,12 @@ def _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, down, i0, i1, lf, mbuf, touc
                 c1 = c - sgn * dirs[1, 1]
                 c2 = c - sgn * dirs[2, 1]
                 cq = c - sgn
-                if z0[r, cq] == zc and z0[rq1, c] == zc and z0[rq1, c1] == zc and z0[rq1, c2] == zc:
+                tc = tr[r, c]
+                if (
+                    z0[r, cq] == zc and z0[rq1, c] == zc and z0[rq1, c1] == zc and z0[rq1, c2] == zc
+                    and _rise(tc, tr[r, cq], kmax) == 0 and _rise(tc, tr[rq1, c], kmax) == 0
+                    and _rise(tc, tr[rq1, c1], kmax) == 0 and _rise(tc, tr[rq1, c2], kmax) == 0
+                ):  # fmt: skip
                     row = (qs1 * nk) * cols
                     hm, m1, m2, m3 = _step4(
                         cf, cb, lf,
@@ -359,7 +364,7 @@ def _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, down, i0, i1, lf, mbuf, touc
                 cq = c - sgn
                 qbs[0] = _U(hoff + ((j - 1) % 2) * w)
                 mqs[0] = hm
-                offs[0] = zc - z0[r, cq]
+                offs[0] = zc - z0[r, cq] - _rise(tr[r, c], tr[r, cq], kmax)
                 p2s[0] = _p2_step(p2m, guide, edge, p1, r, c, r, cq)
             for k in range(nk):
                 dr = dirs[k, 0]
@@ -372,7 +377,7 @@ def _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, down, i0, i1, lf, mbuf, touc
                     qs = (i - dr) % 3
                     qbs[k + 1] = _U(((qs * nk + k) * cols + cq) * w)
                     mqs[k + 1] = mbuf[qs, k, cq]
-                    offs[k + 1] = zc - z0[rq, cq]
+                    offs[k + 1] = zc - z0[rq, cq] - _rise(tr[r, c], tr[rq, cq], kmax)
                     p2s[k + 1] = _p2_step(p2m, guide, edge, p1, r, c, rq, cq)
             g = 0
             assign = touch
@@ -403,8 +408,15 @@ def _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, down, i0, i1, lf, mbuf, touc
                 mbuf[slot, k, c] = mout[k + 1]
 
 
+@njit
+def _rise(tp, tq, kmax):
+    """The trend's rise from q into p if it is a slope (``|rise| <= kmax``), else 0."""
+    d = np.int64(tp) - np.int64(tq)
+    return d if -kmax <= d <= kmax else np.int64(0)
+
+
 @pjit
-def _aggregate_kernel(cost, z0, p2m, guide, edge, p1, s, dirs):
+def _aggregate_kernel(cost, z0, p2m, guide, edge, p1, s, dirs, tr, kmax):
     """Both sweeps on two threads: phase 0 runs the down sweep on the top half
     of the rows and the up sweep on the bottom half (each writes its rows of
     ``s`` first), phase 1 swaps the halves (adding); in each phase the two
@@ -420,11 +432,13 @@ def _aggregate_kernel(cost, z0, p2m, guide, edge, p1, s, dirs):
             if t == 0:
                 a = 0 if phase == 0 else half
                 b = half if phase == 0 else rows
-                _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, True, a, b, lf[:n], mbuf[0], phase == 0)
+                _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, True, a, b, lf[:n], mbuf[0], phase == 0,
+                       tr, kmax)  # fmt: skip
             else:
                 a = 0 if phase == 0 else rows - half
                 b = rows - half if phase == 0 else rows
-                _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, False, a, b, lf[n:], mbuf[1], phase == 0)
+                _sweep(cost, z0, p2m, guide, edge, p1, s, dirs, False, a, b, lf[n:], mbuf[1], phase == 0,
+                       tr, kmax)  # fmt: skip
 
 
 def _check_p(p1, p2, shape) -> tuple[int, np.ndarray]:
@@ -445,6 +459,22 @@ def _check_p(p1, p2, shape) -> tuple[int, np.ndarray]:
     return p1, np.ascontiguousarray(a, dtype=np.int32)
 
 
+#: A cell without a trend (:func:`aggregate`): its rise to any neighbour exceeds every ``trend_max``.
+TREND_NONE = -(1 << 30)
+
+
+def _check_trend(trend, trend_max, shape) -> tuple[np.ndarray, int]:
+    k = trend_max
+    if isinstance(k, bool) or not isinstance(k, int | np.integer) or not 0 <= k < 1 << 20:
+        raise InputError(f"trend_max: expected an integer number of levels in [0, 2^20), got {trend_max!r}")
+    if trend is None or trend_max == 0:
+        return np.zeros(shape, np.int32), 0  # the kernel reads every cell's trend
+    a = np.asarray(trend)
+    if a.shape != shape or not np.issubdtype(a.dtype, np.integer):
+        raise InputError(f"trend: expected an integer array of shape {shape}, got {a.dtype} {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.int32), int(trend_max)
+
+
 def _check_z0(z0, shape) -> np.ndarray:
     if z0 is None:
         return np.zeros(shape, np.int32)
@@ -463,6 +493,8 @@ def aggregate(
     *,
     guide: np.ndarray | None = None,
     edge: float | None = None,
+    trend: np.ndarray | None = None,
+    trend_max: int = 0,
 ) -> np.ndarray:
     """Semi-global aggregation: the sum over paths of the path costs.
 
@@ -492,6 +524,16 @@ def aggregate(
         Guide step that halves P2 (guide units). Default: 4 times the median
         of the non-zero horizontal and vertical guide steps (a typical texture
         step keeps 0.8 P2; invariant to the guide's gain).
+    trend : (rows, cols) integer array, optional
+        A smooth prior of each cell's absolute level (e.g. the coarser pyramid
+        level's surface) or :data:`TREND_NONE`. A step from q into p whose
+        trend rises by ``t = trend[p] - trend[q]`` with ``|t| <= trend_max``
+        compares p's level ``a`` with q's level ``a - t``: a slanted surface
+        that follows the trend pays no P1/P2 for its slope, only for departing
+        from it. Larger rises (height steps) and :data:`TREND_NONE` cells are
+        compared on absolute levels, as without a trend.
+    trend_max : int
+        Largest trend rise per step that is compensated (0: none).
 
     Returns
     -------
@@ -514,7 +556,8 @@ def aggregate(
     g, e = _check_guide(guide, edge, shape)
     c = np.ascontiguousarray(c)
     s = np.empty(c.shape, np.uint16)  # every cell is assigned by its first sweep
-    _aggregate_kernel(c, z, p2m, g, e, p1i, s, _DOWN8 if paths == 8 else _DOWN16)
+    t, kmax = _check_trend(trend, trend_max, shape)
+    _aggregate_kernel(c, z, p2m, g, e, p1i, s, _DOWN8 if paths == 8 else _DOWN16, t, kmax)
     return s
 
 
