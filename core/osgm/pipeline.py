@@ -113,6 +113,7 @@ class OsgmConfig:
     slope_max : int
         Below the coarsest level, SGM follows the coarser level's slopes up to this many Z levels
         per cell (:func:`~.matching.slope_trend`): slanted roofs are not flattened by P1; 0 = off.
+        The coarser surface reaches the tiles with ``adaptive_p2`` only, so it needs that on.
     band : int, optional
         0-based band to match on; default the luminance.
     max_levels : int
