@@ -45,11 +45,25 @@ def commit() -> str:
         return "unknown"
 
 
+def load_average() -> str:
+    """``", load average X at the end"`` where the system has one, else "": a run's times are only
+    comparable with another's on an equally idle machine."""
+    return f", load average {os.getloadavg()[0]:.1f} at the end" if hasattr(os, "getloadavg") else ""
+
+
+def shown_argv(argv: list[str], drop: tuple[str, ...] = ()) -> list[str]:
+    """A bench's arguments as its docs show them: without ``--keep DIR`` (a local folder, not part
+    of what is measured) and without the flags in ``drop``."""
+    out = list(argv)
+    if "--keep" in out:
+        k = out.index("--keep")
+        del out[k : k + 2]
+    return [a for a in out if not a.startswith("--keep=") and a not in drop]
+
+
 def header(command: str, peers: dict[str, str] | None = None) -> str:
     """The line above a section: command, commit, date, machine, peers."""
-    load = ""
-    if hasattr(os, "getloadavg"):
-        load = f", load average {os.getloadavg()[0]:.1f} at the end"
+    load = load_average()
     peer = "; peers: " + ", ".join(f"{k} {v}" for k, v in peers.items()) if peers else ""
     return (
         f"Command: `{command}` at commit {commit()}, {datetime.date.today().isoformat()}, "

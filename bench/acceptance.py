@@ -522,10 +522,11 @@ def run_header(script: str, argv, detail: str = "") -> tuple[str, str, str]:
     cmd = f"python -P bench/{script} " + " ".join(argv if argv is not None else sys.argv[1:])
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()  # fmt: skip
-    # the times are only comparable between runs on an idle machine: say how loaded this one was
-    load = f", load average {os.getloadavg()[0]:.1f} at the end" if hasattr(os, "getloadavg") else ""
+    sys.path.insert(0, HERE)
+    from _docs import load_average
+
     head = (f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {platform.machine()} "
-            f"{os.cpu_count()} cores{load}" + (f", {detail}" if detail else ""))  # fmt: skip
+            f"{os.cpu_count()} cores{load_average()}" + (f", {detail}" if detail else ""))  # fmt: skip
     return cmd, commit, head
 
 

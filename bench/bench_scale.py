@@ -371,13 +371,9 @@ def main(argv=None) -> int:
         json.dump(rows, fh, indent=1)
     if args.write_docs:
         sys.path.insert(0, HERE)
-        from _docs import header, write_section
+        from _docs import header, shown_argv, write_section
 
-        argv = [a for a in sys.argv[1:] if a != "--write-docs"]
-        if "--keep" in argv:  # a local folder, not part of what is measured
-            k = argv.index("--keep")
-            argv = argv[:k] + argv[k + 2 :]
-        argv = [a for a in argv if not a.startswith("--keep=") and a != "--reuse"]
+        argv = shown_argv(sys.argv[1:], drop=("--write-docs", "--reuse"))
         cmd = 'make bench BENCH=scale BENCH_ARGS="' + " ".join(argv) + '"'
         # the 12 MP run (issue 18's goal) and runs at other sizes each keep their own section
         mp = f"{args.megapixels:g}"

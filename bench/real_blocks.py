@@ -231,14 +231,11 @@ def main(argv=None) -> int:
     ]
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()  # fmt: skip
-    shown = list(argv if argv is not None else sys.argv[1:])
-    if "--keep" in shown:  # a local folder, not part of what is measured
-        k = shown.index("--keep")
-        del shown[k : k + 2]
-    shown = [a for a in shown if not a.startswith("--keep=")]
-    cmd = "python -P bench/real_blocks.py " + " ".join(shown)
-    # the s and peak columns are only comparable between runs on an idle machine
-    load = f", load average {os.getloadavg()[0]:.1f} at the end" if hasattr(os, "getloadavg") else ""
+    sys.path.insert(0, HERE)
+    from _docs import load_average, shown_argv
+
+    cmd = "python -P bench/real_blocks.py " + " ".join(shown_argv(argv if argv is not None else sys.argv[1:]))
+    load = load_average()  # the s and peak columns are only comparable on an equally idle machine
     lines = [
         f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {os.cpu_count()} cores{load}",
         "",
