@@ -79,6 +79,7 @@ class TileParams:
     edges: bool = False  # refine the sides of height steps (:mod:`.edges`; the finest level only)
     rim_view_angle: float = 0.0  # steeper views, only where the others leave points short (0 = off)
     slope_max: int = 0  # SGM follows the coarser surface's slopes up to this many levels per cell (0 = off)
+    adaptive_p2: bool = True  # P2 adapts to the image gradient of the coarser surface (needs ``guide_z``)
 
 
 #: Cells of the box mean that smooths the coarser surface into the trend (:func:`slope_trend`).
@@ -448,8 +449,9 @@ def match_tile(
     (:func:`~.levels.refine_bands`; ``gap_lo > gap_hi``: none). A minimum next to a
     gap is rejected like one on the window's border: the surface lies in the gap.
 
-    ``guide_z``: heights of the coarser level at these cells; the images sampled
-    there (median over the views) form the guide of the intensity-adaptive P2.
+    ``guide_z``: heights of the coarser level at these cells. With ``params.adaptive_p2`` the
+    images sampled there (median over the views) form the guide of the intensity-adaptive P2;
+    with ``params.slope_max`` its slopes form the aggregation's trend (:func:`slope_trend`).
     """
     rows, cols = lo.shape
     gaps = None
@@ -483,7 +485,9 @@ def match_tile(
     evaluated = sweep(
         images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps
     )
-    guide = None if guide_z is None else _median_view(sample_surface(images, x0, y0, res, guide_z))
+    guide = None
+    if params.adaptive_p2 and guide_z is not None:
+        guide = _median_view(sample_surface(images, x0, y0, res, guide_z))
     trend = None
     if params.slope_max > 0 and guide_z is not None:
         trend = slope_trend(guide_z, z_base, dz, params.slope_max)

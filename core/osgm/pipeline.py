@@ -113,7 +113,7 @@ class OsgmConfig:
     slope_max : int
         Below the coarsest level, SGM follows the coarser level's slopes up to this many Z levels
         per cell (:func:`~.matching.slope_trend`): slanted roofs are not flattened by P1; 0 = off.
-        The coarser surface reaches the tiles with ``adaptive_p2`` only, so it needs that on.
+        Independent of ``adaptive_p2``: the coarser surface reaches the tiles when either needs it.
     band : int, optional
         0-based band to match on; default the luminance.
     max_levels : int
@@ -248,6 +248,7 @@ class OsgmConfig:
             rim_view_angle=float(self.rim_view_angle),
             edges=bool(self.refine_edges),
             slope_max=int(self.slope_max),
+            adaptive_p2=bool(self.adaptive_p2),
         )
 
 
@@ -352,7 +353,9 @@ class _LevelTasks(Sequence):
                 lo, hi = refine_windows(plan, lv, self.prev_z, (r0, c0, nr, nc))
                 glo = ghi = None
             assert self.prev_filled is not None
-            guide = _interpolate(self.prev_filled, (r0, c0, nr, nc)) if self.cfg.adaptive_p2 else None
+            # the coarser surface, for the adaptive P2's guide and for the slope trend
+            wanted = self.cfg.adaptive_p2 or self.cfg.slope_max > 0
+            guide = _interpolate(self.prev_filled, (r0, c0, nr, nc)) if wanted else None
         search = lo <= hi
         nd = int(max(3, (hi - lo + 1)[search].max())) if search.any() else 0
         self.max_cells_levels = max(self.max_cells_levels, nr * nc * nd)

@@ -699,3 +699,64 @@ def test_assemble_tiles_rejects_bad_input():
         assemble_tiles(grid.shape, tiles, ok, 6, float("nan"))
     with pytest.raises(InputError, match=r"tile \(0, 1\) returned heights \(30, 30\)"):
         assemble_tiles(grid.shape, tiles, [ok[0], (np.zeros((30, 30), np.float32),) * 2], 6, 0.2)
+
+
+@pytest.mark.parametrize("adaptive_p2, slope_max", [(True, 2), (False, 2), (True, 0), (False, 0)])
+def test_slope_trend_and_adaptive_p2_are_independent(small_scene, monkeypatch, adaptive_p2, slope_max):
+    """The coarser surface reaches a tile when either the adaptive P2 or the slope trend needs it,
+    and each uses it only when it is on (the trend used to need ``adaptive_p2``)."""
+    from truortho.core.osgm import matching
+    from truortho.core.osgm.systems import reference_systems, system_views
+    from truortho.core.osgm.views import ImagePyramid
+    from truortho.core.sgm import TREND_NONE
+
+    scene, folder = small_scene
+    o = scene.orientation
+    cfg = OsgmConfig(adaptive_p2=adaptive_p2, slope_max=slope_max, refine_edges=False, median=1)
+    params = cfg.tile_params()
+    assert (params.adaptive_p2, params.slope_max) == (adaptive_p2, slope_max)
+    views = system_views(o, reference_systems(o, "none", 35.0)[0])
+    sizes = [(o.camera_of(im).width, o.camera_of(im).height) for im in o.images]
+    pyr = ImagePyramid([str(folder / im.name) for im in o.images], sizes)
+    res, dz, rows, cols = 0.25, 0.25, 24, 24
+    x0, y0 = -3.0, 3.0
+    lo = np.zeros((rows, cols), np.int32)
+    hi = np.full((rows, cols), 40, np.int32)
+    # a coarser surface rising one level per cell across the tile: a trend wherever it is asked for
+    guide_z = np.tile(-5.0 + dz * np.arange(cols, dtype=np.float64), (rows, 1))
+    seen = {}
+    real = matching.aggregate
+
+    def spy(cost, p1, p2, paths, z0, guide=None, trend=None, trend_max=0):
+        seen.update(guide=guide is not None, trend=trend is not None and (trend != TREND_NONE).any())
+        return real(cost, p1, p2, paths, z0, guide=guide, trend=trend, trend_max=trend_max)
+
+    monkeypatch.setattr(matching, "aggregate", spy)
+    matching.match_tile(views, pyr, x0, y0, res, lo, hi, -10.0, dz, params, guide_z=guide_z)
+    assert seen == {"guide": adaptive_p2, "trend": slope_max > 0}
+
+    # the pipeline hands the coarser surface to the finer levels' tasks when either needs it
+    from truortho.core.osgm.pipeline import _LevelTasks
+
+    g = RasterGrid(0.0, 10.0, 0.25, 40, 40, None)
+    tiles = g.tiles(32, 16)
+    prev = np.zeros((20, 20), np.float32)
+
+    class Plan:
+        z_base = 0.0
+
+        def level_params(self, p, lv):
+            return p
+
+        def dz(self, lv):
+            return dz
+
+        def gaps(self, lv):
+            return False
+
+    import truortho.core.osgm.pipeline as pl
+
+    monkeypatch.setattr(pl, "refine_windows", lambda plan, lv, z, w: (np.zeros(w[2:], np.int32),) * 2)
+    monkeypatch.setattr(pl, "_interpolate", lambda coarse, w: np.zeros(w[2:], np.float32))
+    tasks = _LevelTasks(tiles, g, 0, Plan(), params, cfg, prev, prev, None, 0)
+    assert (tasks[0].guide is not None) == (adaptive_p2 or slope_max > 0)
