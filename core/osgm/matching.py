@@ -108,6 +108,12 @@ def slope_trend(guide_z: np.ndarray, z_base: float, dz: float, slope_max: int) -
     from ..sgm import TREND_NONE
 
     gz = np.asarray(guide_z, np.float64)
+    if gz.ndim != 2:
+        raise InputError(f"slope_trend: expected 2-D coarser heights, got shape {gz.shape}")
+    if not (np.isfinite(dz) and dz > 0):
+        raise InputError(f"slope_trend: dz must be a finite number > 0, got {dz!r}")
+    if isinstance(slope_max, bool) or not isinstance(slope_max, int | np.integer) or slope_max < 0:
+        raise InputError(f"slope_trend: slope_max must be an integer >= 0, got {slope_max!r}")
     ok = np.isfinite(gz)
     num = uniform_filter(np.where(ok, gz, 0.0), TREND_SMOOTH, mode="nearest")
     den = uniform_filter(ok.astype(np.float64), TREND_SMOOTH, mode="nearest")

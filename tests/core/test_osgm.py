@@ -760,3 +760,15 @@ def test_slope_trend_and_adaptive_p2_are_independent(small_scene, monkeypatch, a
     monkeypatch.setattr(pl, "_interpolate", lambda coarse, w: np.zeros(w[2:], np.float32))
     tasks = _LevelTasks(tiles, g, 0, Plan(), params, cfg, prev, prev, None, 0)
     assert (tasks[0].guide is not None) == (adaptive_p2 or slope_max > 0)
+
+
+def test_slope_trend_rejects_bad_input():
+    from truortho.core.osgm.matching import slope_trend
+
+    with pytest.raises(InputError, match="2-D"):
+        slope_trend(np.zeros(5), 0.0, 0.25, 2)
+    with pytest.raises(InputError, match="dz"):
+        slope_trend(np.zeros((4, 4)), 0.0, 0.0, 2)
+    with pytest.raises(InputError, match="slope_max"):
+        slope_trend(np.zeros((4, 4)), 0.0, 0.25, 1.5)
+    assert slope_trend(np.zeros((4, 4)), 0.0, 0.25, 2).shape == (4, 4)
