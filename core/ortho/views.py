@@ -39,7 +39,7 @@ from ..geometry.camera import Camera
 from ..grid import RasterGrid, Tile
 from ..jit import njit
 from .surface import PlanTransform
-from .zbuffer import frame_cells, project, render_depth, view_cells_into
+from .zbuffer import frame_cells, near_step_mask, project, render_depth, view_cells_into
 
 #: Candidates evaluated between two checks of the cells' clean views (``views_per_cell``).
 LAZY_BATCH = 2
@@ -470,6 +470,11 @@ def all_tile_views(
         tris = surface.triangles(region, hreg, include, to_local, setup.wall_min)
     normals3 = _normals(h, res)
     normals = np.ascontiguousarray(normals3.reshape(-1, 3))
+    # next to a much higher cell the raster geometry itself decides the visibility (a ray past a
+    # building's corner: within the depth tolerance, or between two buffer pixel centres)
+    near_field = None
+    if setup.visibility:
+        near_field = (np.where(valid, lz, np.nan).ravel(), near_step_mask(h, res).ravel(), cols)
     # colour sample points: cells next to a height discontinuity are sampled a little inside their own
     # side, so the bilinear sample does not mix in the other side of a building outline
     S = P
@@ -552,6 +557,7 @@ def all_tile_views(
             (usable[r], edge[r], uv[r], eff[r]),
             setup.tol_factor,
             setup.visibility,
+            near_field=near_field,
         )
         gsd_all[r] = gsd
 
