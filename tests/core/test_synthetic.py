@@ -333,3 +333,42 @@ def test_sun_vector_points_to_the_sun():
         _small(jpeg_quality=101)
     with pytest.raises(InputError, match="shadow_strength"):
         _small(shadow_strength=1.5)
+
+
+def _radiometry_reference(colour, camera, radiometry):
+    """The vectorised formula of the module docstring, as numpy evaluates it."""
+    H, W = colour.shape[:2]
+    xs, ys = np.meshgrid(np.arange(W) - camera.cx, np.arange(H) - camera.cy)
+    corner = max(
+        np.hypot(cx, cy)
+        for cx in (-0.5 - camera.cx, W - 0.5 - camera.cx)
+        for cy in (-0.5 - camera.cy, H - 0.5 - camera.cy)
+    )
+    vig = 1.0 - radiometry.vignetting * (np.hypot(xs, ys) / corner) ** 2
+    val = (colour.astype(np.float64) * radiometry.gain + radiometry.offset) * vig[:, :, None] * 255.0
+    if radiometry.noise_sigma > 0:
+        val += np.random.default_rng(radiometry.noise_seed).normal(0.0, radiometry.noise_sigma, val.shape)
+    return np.clip(np.round(val), 0, 255).astype(np.uint8)
+
+
+@pytest.mark.parametrize("noise", [0.0, 2.5])
+def test_apply_radiometry_equals_the_vectorised_formula(noise):
+    """The compiled pass gives exactly the digital numbers of the formula (values below 0 and above
+    1, an off-centre principal point, exact halves rounded to even)."""
+    from truortho.core.synthetic.cameras import make_camera
+    from truortho.core.synthetic.render import Radiometry, apply_radiometry
+
+    rng = np.random.default_rng(5)
+    cam = make_camera(203, 151, 180.0, (3.3, -2.1))
+    colour = rng.uniform(-0.1, 1.1, (151, 203, 3)).astype(np.float32)
+    rad = Radiometry(np.array([1.05, 0.93, 1.2]), np.array([0.01, -0.02, 0.0]), 0.3, noise, 77)
+    assert np.array_equal(apply_radiometry(colour, cam, rad), _radiometry_reference(colour, cam, rad))
+    # DNs exactly half-way (offsets x / 255 with x = 126.5, 127.5, 2.5) are rounded to even, as
+    # np.round does (half up would give 127, 128, 3)
+    flat = make_camera(8, 1, 8.0)
+    halves = Radiometry(np.ones(3), np.array([126.5, 127.5, 2.5]) / 255.0, 0.0, 0.0, 0)
+    dn = apply_radiometry(np.zeros((1, 8, 3), np.float32), flat, halves)
+    assert (dn == np.array([126, 128, 2], np.uint8)).all()
+    plain = Radiometry(np.ones(3), np.zeros(3), 0.0, 0.0, 0)
+    with pytest.raises(InputError, match="apply_radiometry"):
+        apply_radiometry(np.zeros((4, 4)), flat, plain)
