@@ -101,6 +101,11 @@ class TrueOrthoConfig:
         Core tile side in cells (memory grows with its square times the images per tile).
     depth_tolerance : float
         Factor of :func:`~.zbuffer.depth_tolerance`.
+    noise_tolerance : float
+        The depth test also allows ``noise_tolerance * sqrt(2) * sigma / cos(view angle)``, with
+        ``sigma`` the surface's robust local height noise (:func:`~.zbuffer.height_noise`): on a
+        rough matched DSM (low-texture fields, canopies) bumps within the noise do not hide the
+        cells behind them from oblique views. About 0 on smooth surfaces and along walls. 0 = off.
     edge_penalty, smoothness, contrast, discontinuity, sweeps
         Selection energy (:mod:`.select`): penalty for a cell next to an
         occluder, seam weight, weight of the luminance disagreement in a seam,
@@ -176,6 +181,7 @@ class TrueOrthoConfig:
     visibility: bool = True
     tile_size: int = 512
     depth_tolerance: float = 1.0
+    noise_tolerance: float = 2.0
     edge_penalty: float = 1.0
     smoothness: float = 1.0
     contrast: float = 4.0
@@ -228,7 +234,7 @@ class TrueOrthoConfig:
         for name in ("depth_tolerance", "zbuffer_oversample"):
             if not float(getattr(self, name)) > 0:
                 bad(name, "must be positive")
-        for name in ("edge_penalty", "smoothness", "contrast", "discontinuity"):
+        for name in ("edge_penalty", "smoothness", "contrast", "discontinuity", "noise_tolerance"):
             if not float(getattr(self, name)) >= 0:
                 bad(name, "must not be negative")
         if self.extent is not None and len(self.extent) != 4:
@@ -594,6 +600,7 @@ def ortho_candidates(
         cfg.edge_shift,
         views_per_cell=cfg.views_per_cell,
         top_views=cfg.top_views,
+        noise_tolerance=cfg.noise_tolerance,
     )
     if cfg.visibility and setup.margin_cells > 0:
         setup.blocks = HeightBlocks.of(surf, grid, progress=progress)

@@ -39,7 +39,7 @@ from ..geometry.camera import Camera
 from ..grid import RasterGrid, Tile
 from ..jit import njit
 from .surface import PlanTransform
-from .zbuffer import frame_cells, near_step_mask, project, render_depth, view_cells_into
+from .zbuffer import frame_cells, height_noise, near_step_mask, project, render_depth, view_cells_into
 
 #: Candidates evaluated between two checks of the cells' clean views (``views_per_cell``).
 LAZY_BATCH = 2
@@ -65,6 +65,7 @@ class ViewSetup:
     views_per_cell: int = 0  # clean views after which a cell takes no further candidate (0 = all)
     blocks: HeightBlocks | None = None  # block maxima/minima of the surface: a margin per tile
     top_views: int = 0  # keep the candidates among the best this many of some cell (0 = all)
+    noise_tolerance: float = 0.0  # factor of the surface's height noise in the depth tolerance
 
 
 @dataclass
@@ -195,6 +196,7 @@ def prepare_views(
     max_margin_cells: int = 1024,
     views_per_cell: int = 0,
     top_views: int = 0,
+    noise_tolerance: float = 0.0,
 ) -> ViewSetup:
     images = list(orientation.images)
     cams = [orientation.camera_of(im) for im in images]
@@ -223,6 +225,7 @@ def prepare_views(
         int(views_per_cell),
         None,
         int(top_views),
+        float(noise_tolerance),
     )
 
 
@@ -473,8 +476,15 @@ def all_tile_views(
     # next to a much higher cell the raster geometry itself decides the visibility (a ray past a
     # building's corner: within the depth tolerance, or between two buffer pixel centres)
     near_field = None
+    noise = None
     if setup.visibility:
         near_field = (np.where(valid, lz, np.nan).ravel(), near_step_mask(h, res).ravel(), cols)
+        if setup.noise_tolerance > 0:
+            # a rough matched surface (low-texture fields, canopies) hides its own cells from
+            # oblique views behind its noise: bumps within the noise level do not occlude (the
+            # window reaches into the margin, so neighbouring tiles agree)
+            sig = height_noise(hreg)[M : M + rows, M : M + cols]
+            noise = np.ascontiguousarray((setup.noise_tolerance * math.sqrt(2.0) * sig).ravel())
     # colour sample points: cells next to a height discontinuity are sampled a little inside their own
     # side, so the bilinear sample does not mix in the other side of a building outline
     S = P
@@ -558,6 +568,7 @@ def all_tile_views(
             setup.tol_factor,
             setup.visibility,
             near_field=near_field,
+            noise=noise,
         )
         gsd_all[r] = gsd
 

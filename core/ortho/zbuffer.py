@@ -846,6 +846,7 @@ def _view_pass(
     hloc,
     near_step,
     cols,
+    hnoise,
     usable,
     edge,
     uv,
@@ -858,7 +859,8 @@ def _view_pass(
     ``P`` surface points, ``S`` colour sample points (projected only where ``moved``, elsewhere
     ``S`` = ``P``), ``normals`` unit normals, all (N, 3). The buffer pixel of a cell is its image
     pixel at ``scale`` (``x' = (x + 0.5) scale - 0.5``), the buffer window's origin ``(x0, y0)``.
-    Tolerance as :func:`depth_tolerance`. Where ``near_step`` is set (cells of a ``cols``-wide grid,
+    Tolerance as :func:`depth_tolerance`, plus ``hnoise / cos(view angle)`` (the surface's own
+    height noise, :func:`height_noise`). Where ``near_step`` is set (cells of a ``cols``-wide grid,
     heights ``hloc``, NaN = none), a cell that passes the depth test is still hidden when its ray
     enters a neighbouring cell below that cell's top (:func:`_near_field_hidden`).
     """
@@ -887,7 +889,7 @@ def _view_pass(
             foot = dist / (fx * scale) / cos_view
             nz = max(abs(normals[n, 2]), 1e-6)
             slope = math.sqrt(max(1.0 - nz * nz, 0.0)) / nz  # the cell's own stair step per cell
-            t = tol_factor * (max(res, foot) * (1.0 + tan_view) + res * slope)
+            t = tol_factor * (max(res, foot) * (1.0 + tan_view) + res * slope) + hnoise[n] / cos_view
             if z > zbuf[j, i] + t:
                 continue
             zmin = np.inf
@@ -989,6 +991,7 @@ def view_cells_into(
     visibility: bool = True,
     min_cos_inc: float = 0.02,
     near_field: tuple | None = None,
+    noise: np.ndarray | None = None,
 ) -> int:
     """Per-cell result of one image in one pass (the depth test of :func:`point_visibility` +
     incidence + sampling) for the cells of :func:`frame_cells`.
@@ -1011,9 +1014,13 @@ def view_cells_into(
         heights (local z, NaN = no data); where ``near_step`` is set (a much higher cell within two
         cells, :func:`near_step_mask`), a cell visible in the buffer is still hidden when its ray
         towards the camera enters a neighbouring cell below that cell's top by more than the
-        stair step of the cell's own slope. The depth buffer cannot see such occluders: their
+        depth tolerance. The depth buffer cannot see such occluders: their
         depth lies within the tolerance, or between two buffer pixel centres (a ground cell
         diagonally next to a building's corner, seen past the corner).
+    noise : (N,) float64, optional
+        With the depth test: a height tolerance per cell (metres, >= 0) for the surface's own noise,
+        added to the depth tolerance divided by the cosine of the viewing angle (see
+        :func:`height_noise`); default 0.
 
     Returns
     -------
@@ -1053,6 +1060,12 @@ def view_cells_into(
                 "view_cells_into: near_field must be (N,) heights, (N,) bool and the grid's columns"
             )
         hloc = np.ascontiguousarray(hloc, np.float64)
+    if noise is None:
+        hnoise = np.zeros(n)
+    else:
+        hnoise = np.ascontiguousarray(noise, np.float64)
+        if hnoise.shape != (n,):
+            raise InputError(f"view_cells_into: noise must be ({n},) heights, got shape {hnoise.shape}")
     return int(
         _view_pass(
             fc.cells,
@@ -1079,6 +1092,7 @@ def view_cells_into(
             hloc,
             near_step,
             cols,
+            hnoise,
             usable,
             edge,
             uv,
@@ -1099,3 +1113,55 @@ def near_step_mask(heights: np.ndarray, res: float, step_cells: float = 2.0) -> 
     top = maximum_filter(hz, size=5, mode="constant", cval=-np.inf)
     with np.errstate(invalid="ignore"):
         return np.isfinite(h) & (top - h > float(step_cells) * float(res))
+
+
+
+def height_noise(heights: np.ndarray, half: int = 3, scale: int = 9) -> np.ndarray:
+    """Robust local height noise (rows, cols) float64, metres, of a height grid (NaN = no data).
+
+    ``1.4826 x`` the median over the ``(2 half + 1)^2`` window of ``|h - median_scale(h)|``, the
+    departures from the ``scale x scale`` median surface: the deviation of the bumps shorter than
+    about ``scale`` cells (a matched DSM's noise is correlated over the matching window, so a
+    second difference would read a fraction of it). The median surface keeps planes, straight
+    walls, corners and buildings wider than half the window, so they read 0; a matched DSM of
+    low-texture fields or a canopy reads its roughness. Cells without a height take the nearest
+    height for the median surface and are left out of the window medians; 0 where fewer than 9
+    cells of the window have a value.
+    """
+    from scipy.ndimage import distance_transform_edt, median_filter
+
+    h = np.ascontiguousarray(np.asarray(heights, dtype=np.float64))
+    if h.ndim != 2:
+        raise InputError(f"height_noise: expected a 2-D height grid, got shape {h.shape}")
+    for name, v, lo, hi in (("half", half, 1, 7), ("scale", scale, 3, 31)):
+        if isinstance(v, bool) or not isinstance(v, int | np.integer) or not lo <= v <= hi:
+            raise InputError(f"height_noise: {name} must be an integer from {lo} to {hi}, got {v!r}")
+    valid = np.isfinite(h)
+    out = np.zeros(h.shape)
+    if not valid.any():
+        return out
+    filled = h
+    if not valid.all():
+        idx = distance_transform_edt(~valid, return_distances=False, return_indices=True)
+        filled = h[tuple(idx)]
+    dev = np.where(valid, np.abs(h - median_filter(filled, size=int(scale), mode="nearest")), np.nan)
+    _window_median(np.ascontiguousarray(dev), int(half), out)
+    return 1.4826 * out
+
+
+@njit
+def _window_median(d, half, out):
+    """``out[r, c]``: the median of the finite ``d`` in the window (left as is with fewer than 9)."""
+    rows, cols = d.shape
+    buf = np.empty((2 * half + 1) ** 2)
+    for r in range(rows):
+        for c in range(cols):
+            m = 0
+            for rr in range(max(r - half, 0), min(r + half + 1, rows)):
+                for cc in range(max(c - half, 0), min(c + half + 1, cols)):
+                    v = d[rr, cc]
+                    if v == v:
+                        buf[m] = v
+                        m += 1
+            if m >= 9:
+                out[r, c] = np.median(buf[:m])

@@ -14,6 +14,7 @@ from truortho.core.ortho.zbuffer import (
     dsm_triangles,
     face_normals,
     frame_cells,
+    height_noise,
     near_step_mask,
     point_visibility,
     render_depth,
@@ -306,3 +307,70 @@ def test_near_step_mask_marks_cells_within_two_cells_of_a_higher_one():
     assert not near_step_mask(h, 0.25, step_cells=4.0).any()
     with pytest.raises(Exception, match="near_step_mask"):
         near_step_mask(np.zeros(5), 0.25)
+
+
+
+def test_height_noise_reads_bumps_not_structures():
+    rng = np.random.default_rng(11)
+    r, c = np.mgrid[0:80, 0:80]
+    # white noise: the deviation; correlated bumps (a matched DSM's noise): about their deviation
+    assert abs(np.median(height_noise(rng.normal(0.0, 0.3, (200, 200)))) - 0.3) < 0.03
+    from scipy.ndimage import gaussian_filter
+
+    bumps = gaussian_filter(rng.normal(0.0, 1.0, (200, 200)), 1.0)
+    bumps *= 0.4 / bumps.std()
+    assert 0.2 < np.median(height_noise(bumps)) < 0.45
+    # planes, straight and diagonal walls, corners, a small building: 0
+    shapes = [
+        0.3 * c + 0.1 * r,
+        np.where(c >= 40, 10.0, 0.0),
+        np.where(r + c > 80, 10.0, 0.0),
+        np.where((r >= 40) & (c >= 40), 10.0, 0.0),
+        np.where((r >= 20) & (r < 28) & (c >= 20) & (c < 28), 3.0, 0.0),
+    ]
+    for h in shapes:  # (the median surface is extended at the border: the interior is exact)
+        assert np.abs(height_noise(h)[10:-10, 10:-10]).max() < 1e-9
+    # no data: left out, not read as a step
+    h = np.zeros((40, 40))
+    h[10:20, 10:20] = np.nan
+    assert np.abs(height_noise(h)).max() < 1e-9
+    with pytest.raises(Exception, match="height_noise"):
+        height_noise(np.zeros(5))
+
+
+def test_noise_tolerance_lets_a_cell_be_seen_past_bumps_of_the_noise_level():
+    """Seen at 45 degrees from the east, a cell 0.75 m west of a 1 m bump (a matched DSM's noise on a
+    field) is hidden by the depth test alone and seen with a height tolerance of 2 sqrt(2) x 0.3 m;
+    a cell 1.9 m west of a 5 m wall stays hidden with the same tolerance."""
+    res = 0.25
+    h = np.zeros((3, 16))
+    h[0, 8] = 1.0  # bump, 3 cells east of cell (0, 5)
+    h[2, 8:10] = 5.0  # wall, 8 cells east of cell (2, 0)
+    cols = h.shape[1]
+    r, c = np.mgrid[0:3, 0:cols]
+    P = np.column_stack([((c + 0.5) * res).ravel(), (-(r + 0.5) * res).ravel(), h.ravel()])
+    target = P[1 * cols + 4]
+    C = np.array([target[0] + 40.0, target[1], 40.0])  # 45 degrees to the east
+    R = look_at_rotation(C, target)
+    cam = Camera(800, 800, 2000.0, 2000.0, 399.5, 399.5)
+    tris = dsm_triangles(h, 0.0, 0.0, res)
+    fc = frame_cells(P, R, C, cam, np.radians(50.0))
+    assert len(fc) == len(P)
+    win = (0, 0, 800, 800)
+    zbuf = render_depth(tris, R, C, cam, win, 1.0)
+    n = len(P)
+    normals = np.tile([0.0, 0.0, 1.0], (n, 1))
+
+    def usable(noise):
+        out = (np.zeros(n, bool), np.zeros(n, bool), np.zeros((n, 2), np.float32), np.zeros(n, np.float32))
+        view_cells_into(fc, P, P, np.zeros(n, bool), normals, R, C, cam, zbuf, win, 1.0, res, out,
+                        noise=noise)  # fmt: skip
+        return out[0].reshape(h.shape)
+
+    strict = usable(None)
+    lenient = usable(np.full(n, 2.0 * np.sqrt(2.0) * 0.3))  # 2 sqrt(2) sigma, sigma = 0.3 m
+    assert not strict[0, 5] and lenient[0, 5]
+    assert not strict[2, 0] and not lenient[2, 0]
+    assert (lenient >= strict).all()
+    with pytest.raises(Exception, match="noise"):
+        usable(np.zeros(3))
