@@ -481,6 +481,7 @@ def summary(rows: list[dict]) -> list[str]:
         "ortho_truth.relative_dE",
         "ortho_osgm.mean_dE",
         "ortho_osgm.relative_dE",
+        "ortho_osgm.wrong_fill",
         "ortho_conventional.ghosting",
         "osgm.streak_index",
         "truth_streak_index",
