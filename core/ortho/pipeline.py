@@ -938,11 +938,18 @@ def open_products(
     return w_out, w_idx, w_occ
 
 
+#: Part of every cached tile's key: raise it when a change of the visibility, selection or mosaic
+#: changes the tiles for the same inputs and parameters (2: near-field visibility, noise tolerance),
+#: so that a cache kept from an interrupted run of an older version is not reused.
+CACHE_VERSION = 2
+
+
 def _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs) -> str:
     """Identity of a run's inputs and parameters: every tile key starts from it."""
     import dataclasses
 
-    d = Digest("true-ortho", [file_identity(paths[i]) for i in relevant], out_crs, list(grid.geotransform))
+    files = [file_identity(paths[i]) for i in relevant]
+    d = Digest("true-ortho", CACHE_VERSION, files, out_crs, list(grid.geotransform))
     d.add([grid.rows, grid.cols])
     d.add(o.to_dict())  # cameras, poses, offset, CRS (as OSGM's key)
     path = getattr(surf, "path", None)

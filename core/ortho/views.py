@@ -481,8 +481,8 @@ def all_tile_views(
         near_field = (np.where(valid, lz, np.nan).ravel(), near_step_mask(h, res).ravel(), cols)
         if setup.noise_tolerance > 0:
             # a rough matched surface (low-texture fields, canopies) hides its own cells from
-            # oblique views behind its noise: bumps within the noise level do not occlude (the
-            # window reaches into the margin, so neighbouring tiles agree)
+            # oblique views behind its noise: bumps within the noise level do not occlude (computed
+            # on the region with its margin, so cells at the window's border see their neighbours)
             sig = height_noise(hreg)[M : M + rows, M : M + cols]
             noise = np.ascontiguousarray((setup.noise_tolerance * math.sqrt(2.0) * sig).ravel())
     # colour sample points: cells next to a height discontinuity are sampled a little inside their own

@@ -154,6 +154,20 @@ def test_cache_reuses_tiles_of_the_same_run_only(scene, reference, tmp_path):
     assert not _same(_products(tmp_path / "c"), reference[0])
 
 
+def test_cache_of_another_version_is_not_reused(scene, reference, tmp_path, monkeypatch):
+    """Tiles cached by a version whose visibility or mosaic differed are not reused (the key holds
+    the module's CACHE_VERSION)."""
+    from truortho.core.ortho import pipeline
+
+    cache = tmp_path / "cache"
+    monkeypatch.setattr(pipeline, "CACHE_VERSION", pipeline.CACHE_VERSION - 1)
+    assert _run(scene, tmp_path / "old", cache_dir=cache).stats["tile_cache"]["written"] == 12
+    monkeypatch.undo()
+    r = _run(scene, tmp_path / "new", cache_dir=cache)
+    assert r.stats["tile_cache"] == {"hits": 0, "written": 12}
+    assert _same(_products(tmp_path / "new"), reference[0])
+
+
 def test_rerun_after_a_crash_resumes_from_the_finished_tiles(scene, reference, tmp_path):
     seen = []
 
