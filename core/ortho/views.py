@@ -41,6 +41,10 @@ from ..jit import njit
 from .surface import PlanTransform
 from .zbuffer import frame_cells, height_noise, near_step_mask, project, render_depth, view_cells_into
 
+#: Cells around a tile's window that :func:`~.zbuffer.height_noise` reads (9 x 9 median surface,
+#: 7 x 7 window median).
+NOISE_REACH = 9 // 2 + 3
+
 #: Candidates evaluated between two checks of the cells' clean views (``views_per_cell``).
 LAZY_BATCH = 2
 
@@ -483,7 +487,9 @@ def all_tile_views(
             # a rough matched surface (low-texture fields, canopies) hides its own cells from
             # oblique views behind its noise: bumps within the noise level do not occlude (computed
             # on the region with its margin, so cells at the window's border see their neighbours)
-            sig = height_noise(hreg)[M : M + rows, M : M + cols]
+            # the median surface and the window median read 4 + 3 cells around a cell: no farther
+            k = min(M, NOISE_REACH)
+            sig = height_noise(hreg[M - k : M + rows + k, M - k : M + cols + k])[k : k + rows, k : k + cols]
             noise = np.ascontiguousarray((setup.noise_tolerance * math.sqrt(2.0) * sig).ravel())
     # colour sample points: cells next to a height discontinuity are sampled a little inside their own
     # side, so the bilinear sample does not mix in the other side of a building outline

@@ -1064,8 +1064,10 @@ def view_cells_into(
         hnoise = np.zeros(n)
     else:
         hnoise = np.ascontiguousarray(noise, np.float64)
-        if hnoise.shape != (n,):
-            raise InputError(f"view_cells_into: noise must be ({n},) heights, got shape {hnoise.shape}")
+        if hnoise.shape != (n,) or not (hnoise >= 0).all():
+            raise InputError(
+                f"view_cells_into: noise must be ({n},) heights >= 0, got shape {hnoise.shape}"
+            )
     return int(
         _view_pass(
             fc.cells,
@@ -1109,11 +1111,13 @@ def near_step_mask(heights: np.ndarray, res: float, step_cells: float = 2.0) -> 
     h = np.asarray(heights, dtype=np.float64)
     if h.ndim != 2:
         raise InputError(f"near_step_mask: expected a 2-D height grid, got shape {h.shape}")
+    for name, v in (("res", res), ("step_cells", step_cells)):
+        if isinstance(v, bool) or not (math.isfinite(float(v)) and float(v) > 0):
+            raise InputError(f"near_step_mask: {name} must be a finite number > 0, got {v!r}")
     hz = np.where(np.isfinite(h), h, -np.inf)
     top = maximum_filter(hz, size=5, mode="constant", cval=-np.inf)
     with np.errstate(invalid="ignore"):
         return np.isfinite(h) & (top - h > float(step_cells) * float(res))
-
 
 
 def height_noise(heights: np.ndarray, half: int = 3, scale: int = 9) -> np.ndarray:
@@ -1125,10 +1129,12 @@ def height_noise(heights: np.ndarray, half: int = 3, scale: int = 9) -> np.ndarr
     second difference would read a fraction of it). The median surface keeps planes, straight
     walls, corners and buildings wider than half the window, so they read 0; a matched DSM of
     low-texture fields or a canopy reads its roughness. Cells without a height take the nearest
-    height for the median surface and are left out of the window medians; 0 where fewer than 9
-    cells of the window have a value.
+    height for the median surface and are left out of the window medians; 0 at cells without a
+    height and where fewer than 9 cells of the window have one.
     """
     from scipy.ndimage import distance_transform_edt, median_filter
+
+    from ..sgm import median_filter as nan_median_filter
 
     h = np.ascontiguousarray(np.asarray(heights, dtype=np.float64))
     if h.ndim != 2:
@@ -1137,31 +1143,13 @@ def height_noise(heights: np.ndarray, half: int = 3, scale: int = 9) -> np.ndarr
         if isinstance(v, bool) or not isinstance(v, int | np.integer) or not lo <= v <= hi:
             raise InputError(f"height_noise: {name} must be an integer from {lo} to {hi}, got {v!r}")
     valid = np.isfinite(h)
-    out = np.zeros(h.shape)
     if not valid.any():
-        return out
+        return np.zeros(h.shape)
     filled = h
     if not valid.all():
         idx = distance_transform_edt(~valid, return_distances=False, return_indices=True)
         filled = h[tuple(idx)]
     dev = np.where(valid, np.abs(h - median_filter(filled, size=int(scale), mode="nearest")), np.nan)
-    _window_median(np.ascontiguousarray(dev), int(half), out)
-    return 1.4826 * out
-
-
-@njit
-def _window_median(d, half, out):
-    """``out[r, c]``: the median of the finite ``d`` in the window (left as is with fewer than 9)."""
-    rows, cols = d.shape
-    buf = np.empty((2 * half + 1) ** 2)
-    for r in range(rows):
-        for c in range(cols):
-            m = 0
-            for rr in range(max(r - half, 0), min(r + half + 1, rows)):
-                for cc in range(max(c - half, 0), min(c + half + 1, cols)):
-                    v = d[rr, cc]
-                    if v == v:
-                        buf[m] = v
-                        m += 1
-            if m >= 9:
-                out[r, c] = np.median(buf[:m])
+    # the NaN-aware window median of the matching's outlier test; NaN where fewer than 9 values
+    med = nan_median_filter(dev, 2 * int(half) + 1, min_count=9)
+    return 1.4826 * np.nan_to_num(med.astype(np.float64), nan=0.0)

@@ -280,7 +280,8 @@ def apply_radiometry(colour: np.ndarray, camera: Camera, radiometry: Radiometry)
 
     One compiled pass over the pixels (the noise is drawn by numpy, as before): the same float64
     operations in the same order, rounding half to even like ``np.round``, so the result is
-    identical to the vectorised formula, about four times faster on a 12 MP image.
+    identical to the vectorised formula (on a 12 MP image about 5 times faster without noise, 2.4
+    times with it: the normal draws remain).
     """
     H, W = colour.shape[:2]
     if colour.ndim != 3 or colour.shape[2] != 3:
