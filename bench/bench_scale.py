@@ -311,8 +311,15 @@ def main(argv=None) -> int:
         action="store_true",
         help="with --keep: run again on the blocks already rendered there (their render.json)",
     )
+    ap.add_argument(
+        "--render-only",
+        action="store_true",
+        help="with --keep: render the blocks (render.json) and stop; a later --reuse run measures them",
+    )
     ap.add_argument("--write-docs", action="store_true", help=f"update the scale section of {DOCS}")
     args = ap.parse_args(argv)
+    if args.render_only and (not args.keep or args.write_docs):
+        raise SystemExit("--render-only: needs --keep DIR (where the blocks stay) and no --write-docs")
     sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
     if not sizes or min(sizes) < 6:
         raise SystemExit("--sizes: expected photo counts of at least 6")
@@ -349,6 +356,9 @@ def main(argv=None) -> int:
                 f"GNSS sigma {info['gnss_sigma_m']} m"
             )
             blocks.append((folder, info))
+        if args.render_only:
+            log(f"rendered {len(blocks)} blocks in {base}; measure them with --keep {base} --reuse")
+            return 0
         for folder, info in blocks:
             log(f"pipeline on {info['photos']} photos ({folder}):")
             info["run"] = run_pipeline(folder, info["checks"], args.resolution, log)

@@ -61,6 +61,12 @@ from .zrange import check_overlap, default_extent, default_resolution, known_hei
 
 DSM_NODATA = -9999.0
 
+#: Part of every cached tile's key: raise it when a change of the matching or of the edge
+#: refinement changes the tiles for the same inputs and parameters (2: the edge refinement's
+#: visibility march and better-half cost), so that a cache kept from an interrupted run of an
+#: older version is not reused.
+CACHE_VERSION = 2
+
 
 @dataclass
 class OsgmConfig:
@@ -600,6 +606,7 @@ def run_osgm(
     # everything a tile's result depends on besides its own inputs: block, parameters, grid, Z surface
     cache_base = Digest(
         "osgm-run",
+        CACHE_VERSION,
         o.to_dict(),
         cfg.result_fields(),
         [local.x_min, local.y_max, local.res, local.rows, local.cols],

@@ -168,6 +168,21 @@ def test_cache_reuses_tiles_of_the_same_run_only(scene, reference, tmp_path):
 
 
 @pytest.mark.slow
+def test_cache_of_another_version_is_not_reused(scene, reference, tmp_path, monkeypatch):
+    """Tiles cached by a version whose matching differed are not reused (the key holds the module's
+    CACHE_VERSION)."""
+    from truortho.core.osgm import pipeline
+
+    cache = tmp_path / "cache"
+    monkeypatch.setattr(pipeline, "CACHE_VERSION", pipeline.CACHE_VERSION - 1)
+    assert _run(scene, tmp_path / "old", cache_dir=cache).stats["cache_tiles_written"] == 8
+    monkeypatch.undo()
+    r = _run(scene, tmp_path / "new", cache_dir=cache)
+    assert (r.stats["cache_hits"], r.stats["cache_tiles_written"]) == (0, 8)
+    assert _same(_products(tmp_path / "new"), reference)
+
+
+@pytest.mark.slow
 def test_rerun_after_a_crash_resumes_from_the_finished_tiles(scene, reference, tmp_path):
     """A run dies after 4 tiles; its scratch tiles stay beside the DSM, the rerun computes only the rest."""
     done = []
