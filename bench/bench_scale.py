@@ -188,16 +188,41 @@ def render_block(n_images: int, megapixels: float, seed: int, folder: str, log) 
     names = {}
     t = time.perf_counter()
 
+    # a render interrupted half way resumes: the photos it wrote (whole files, written by rename)
+    # are kept if the block is the same (seed and megapixels in render.partial.json)
+    partial = os.path.join(folder, "render.partial.json")
+    key = {"seed": seed, "megapixels": megapixels, "photos": n_images}
+    same = False
+    if os.path.isfile(partial):
+        with open(partial) as fh:
+            same = json.load(fh) == key
+    if not same:
+        shutil.rmtree(images, ignore_errors=True)
+        os.makedirs(images)
+        with open(partial, "w") as fh:
+            json.dump(key, fh)
+    kept = []
+
+    def jpg(im):
+        return os.path.join(images, os.path.splitext(im.name)[0] + ".jpg")
+
+    def skip(k, im):
+        return same and os.path.isfile(jpg(im))
+
     def sink(k, im, rgb):
         C = im.C + off + rng.normal(0.0, sigma, 3)
+        names[im.name] = os.path.basename(jpg(im))
+        if rgb is None:
+            kept.append(k)
+            return
         lon, lat = to_wgs.transform(C[0], C[1])
-        name = os.path.splitext(im.name)[0] + ".jpg"
-        names[im.name] = name
-        jpeg_with_gnss(os.path.join(images, name), rgb, lat, lon, float(C[2]), cfg.focal_px)
+        jpeg_with_gnss(jpg(im), rgb, lat, lon, float(C[2]), cfg.focal_px)
         if (k + 1) % 25 == 0:
             log(f"    rendered {k + 1} photos ({time.perf_counter() - t:.0f} s)")
 
-    scene = make_scene(cfg, image_sink=sink)
+    scene = make_scene(cfg, image_sink=sink, skip_image=skip)
+    if kept:
+        log(f"    resumed: {len(kept)} photos were already rendered")
     lines = [cfg.crs]
     for g in scene.orientation.gcps:
         for name, u, v in g.observations:
@@ -216,6 +241,7 @@ def render_block(n_images: int, megapixels: float, seed: int, folder: str, log) 
         "gcps": len(scene.orientation.gcps),
         "checks": checks,
         "render_s": round(time.perf_counter() - t, 1),
+        "render_resumed_photos": len(kept),
     }
 
 
@@ -266,6 +292,12 @@ def run_pipeline(folder: str, checks: list[str], resolution: float, log) -> dict
     }
 
 
+def render_cell(r: dict) -> str:
+    """Render seconds; a resumed render's time is that of the photos it rendered last."""
+    kept = r.get("render_resumed_photos", 0)
+    return f"{r['render_s']:.0f}" + (f" (resumed, {kept} kept)" if kept else "")
+
+
 def table(rows: list[dict]) -> list[str]:
     names: list[str] = []
     for r in rows:
@@ -284,7 +316,7 @@ def table(rows: list[dict]) -> list[str]:
         peak = r["run"].get("peak_mb")  # the qgis_process's peak RSS (else the stages' own)
         if peak is None:
             peak = max((s[2] for s in r["run"]["stages"] if s[2] is not None), default=float("nan"))
-        cells = [str(r["photos"]), f"{r['megapixels']:.1f}", f"{r['area_m']:.0f}", f"{r['render_s']:.0f}",
+        cells = [str(r["photos"]), f"{r['megapixels']:.1f}", f"{r['area_m']:.0f}", render_cell(r),
                  f"{wall:.0f}", f"{wall / r['photos']:.2f}", f"{peak:.0f}"]  # fmt: skip
         cells += [f"{st[n][1]:.0f}" if n in st else "" for n in names]
         out.append("| " + " | ".join(cells) + " |")

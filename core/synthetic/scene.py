@@ -274,7 +274,7 @@ def _write_geotiff(path: Path, bands: np.ndarray, gt, crs: str, nodata) -> None:
 
 
 def make_scene(
-    config: SceneConfig | None = None, progress: Progress | None = None, image_sink=None
+    config: SceneConfig | None = None, progress: Progress | None = None, image_sink=None, skip_image=None
 ) -> SyntheticScene:
     """Build, render and control a synthetic block (deterministic in ``config``).
 
@@ -286,11 +286,19 @@ def make_scene(
     ``image_sink(index, image, rgb)``: when given, every rendered image is
     handed to it and not kept (``scene.images`` stays empty), so that blocks
     of hundreds of large images are rendered in bounded memory.
+
+    ``skip_image(index, image) -> bool`` (with ``image_sink``): the images it
+    accepts are not rendered and reach the sink with ``rgb=None`` (a render
+    interrupted half way resumes with the images it has not written). Their
+    random draws are still made, so every other image is the same as in a
+    full render.
     """
     cfg = config if config is not None else SceneConfig()
     if not isinstance(cfg, SceneConfig):
         raise InputError(f"make_scene: expected a SceneConfig, got {type(cfg).__name__}")
     cfg.validate()
+    if skip_image is not None and image_sink is None:
+        raise InputError("make_scene: skip_image needs an image_sink (the skipped images are not kept)")
     progress = as_progress(progress)
     surface = Surface(cfg)
     w, h = cfg.image_size
@@ -318,11 +326,15 @@ def make_scene(
     sub = scene._subpixel(cfg.supersample) if cfg.supersample > 1 else None
     for k, im in enumerate(images):
         check(progress)
-        colour, _, _, _ = render_colour(surface, scene.palette, scene.tex, im.R, im.C, scene._subpixel(1),
-                                        sub, cfg.adaptive_supersampling, sun)
         rad = random_radiometry(rng, cfg.gain_sigma, cfg.offset_sigma, cfg.vignetting, cfg.noise_sigma,
                                 cfg.seed * 1000 + k)
         scene.radiometry.append(rad)
+        if skip_image is not None and skip_image(k, im):
+            image_sink(k, im, None)
+            progress.update(0.95 * (k + 1) / len(images), f"kept {im.name}")
+            continue
+        colour, _, _, _ = render_colour(surface, scene.palette, scene.tex, im.R, im.C, scene._subpixel(1),
+                                        sub, cfg.adaptive_supersampling, sun)
         rgb = jpeg_roundtrip(apply_radiometry(colour, cam, rad), cfg.jpeg_quality)
         if image_sink is None:
             scene.images.append(rgb)

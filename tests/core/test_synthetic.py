@@ -63,6 +63,23 @@ def test_image_sink_receives_the_same_images_and_keeps_none():
     assert a.orientation.to_dict() == b.orientation.to_dict()
 
 
+def test_skipped_images_leave_the_others_unchanged():
+    """A resumed render (skip_image) draws the skipped images' random numbers all the same: the images
+    it renders equal those of a full render, the skipped ones reach the sink as None."""
+    a = make_scene(_small(noise_sigma=2.0))
+    got = {}
+    make_scene(
+        _small(noise_sigma=2.0),
+        image_sink=lambda k, im, rgb: got.__setitem__(k, rgb),
+        skip_image=lambda k, im: k % 2 == 0,
+    )
+    assert sorted(got) == list(range(len(a.images)))
+    for k, x in enumerate(a.images):
+        assert (got[k] is None) if k % 2 == 0 else np.array_equal(got[k], x)
+    with pytest.raises(InputError, match="skip_image needs an image_sink"):
+        make_scene(_small(), skip_image=lambda k, im: True)
+
+
 def test_block_layout(scene):
     o = scene.orientation
     assert o.crs == "EPSG:32632"
