@@ -527,6 +527,29 @@ def test_edge_visibility_march_starts_beyond_the_band_it_redecides():
     assert not out[0]
 
 
+def test_edge_decision_takes_wall_heights_and_holes_outright():
+    """Side decision (core/osgm/edges.py): a height half way up a wall or a hole takes the better side
+    outright; a height on one side moves only on clear evidence (RATIO); nothing is decided without a
+    pair of views on each side or sides less than a step apart."""
+    from truortho.core.osgm.edges import RATIO, _decide
+
+    step = 1.0
+    zc = np.array([0.1, 0.1, 5.0, np.nan, 0.1, 5.0, 9.9])
+    lo = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    hi = np.array([10.0, 10.0, 10.0, 10.0, 10.0, 0.5, 10.0])
+    mid = (lo + hi) / 2
+    c_hi = np.array([0.99 * RATIO, 0.9, 0.9, 0.5, 0.1, 0.1, 0.5])  # the high side's cost; low's is 1
+    cost = np.stack([np.ones(7), c_hi])
+    npairs = np.array([[3, 3, 3, 3, 0, 3, 3], [3, 3, 3, 3, 3, 3, 3]])
+    side, switch, fill = _decide(zc, np.stack([lo, hi]), mid, cost, npairs, step)
+    # 0: ground, the roof clearly better -> switches; 1: not clear enough -> stays;
+    # 2: wall height, roof a bit better -> takes the roof; 3: hole -> roof;
+    # 4: no pair on the low side -> undecided; 5: sides 0.5 apart -> no step; 6: on the roof side
+    assert switch.tolist() == [True, False, False, False, False, False, False]
+    assert fill.tolist() == [False, False, True, True, False, False, False]
+    assert side[2] == 1 and side[3] == 1 and side[6] == 1
+
+
 def test_edge_consistency_outvotes_one_occluded_view():
     """The side cost is the mean of the better half of the pair differences: three views that agree
     and one that sees something else cost 0 (a mean over all pairs would not); no pair, no cost."""
