@@ -55,7 +55,6 @@ import math
 import os
 import platform
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -528,14 +527,22 @@ def scene_table(rows: list[dict]) -> list[str]:
     return lines
 
 
-def run_header(script: str, argv, detail: str = "") -> tuple[str, str, str]:
+def run_header(script: str, argv, detail: str = "", started: str | None = None) -> tuple[str, str, str]:
     """``(command, commit, head)`` of a run of ``bench/<script>``: the head line of its docs section
-    (command, commit, date, machine, ``detail``)."""
+    (command, commit, date, machine, ``detail``).
+
+    ``started``: the commit when the run started (:func:`_docs.commit`, ``+dirty`` for a changed
+    tree); the figures are that code's. If HEAD moved during the run, the head says so.
+    """
     cmd = f"python -P bench/{script} " + " ".join(argv if argv is not None else sys.argv[1:])
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()  # fmt: skip
     sys.path.insert(0, HERE)
+    from _docs import commit as head_commit
     from _docs import load_average
+
+    now = head_commit()
+    commit = started or now
+    if started and now != started:
+        commit = f"{started} (HEAD moved to {now} during the run)"
 
     head = (f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {platform.machine()} "
             f"{os.cpu_count()} cores{load_average()}" + (f", {detail}" if detail else ""))  # fmt: skip
@@ -585,6 +592,10 @@ def main(argv=None) -> int:
     def log(msg: str) -> None:
         print(msg, flush=True)
 
+    sys.path.insert(0, HERE)
+    from _docs import commit as head_commit
+
+    started = head_commit()  # the code measured: taken before the run, not after it
     t0 = time.perf_counter()
     rows = []
     try:
@@ -596,7 +607,7 @@ def main(argv=None) -> int:
     wall = time.perf_counter() - t0
     import cv2
 
-    cmd, commit, head = run_header("acceptance.py", argv, f"OpenCV {cv2.__version__}")
+    cmd, commit, head = run_header("acceptance.py", argv, f"OpenCV {cv2.__version__}", started)
     head += f"; {len(rows)} scenes, master seed {args.seed}, {wall / 60:.1f} min"
     text = "\n".join([head, "", *summary(rows), "", *scene_table(rows), ""])
     print("\n" + text)

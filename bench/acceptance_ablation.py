@@ -40,6 +40,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 
 import acceptance  # noqa: E402
+from _docs import commit as acceptance_commit  # noqa: E402
 
 #: (name, SceneConfig changes)
 VARIANTS = (
@@ -136,10 +137,11 @@ def main(argv=None) -> int:
     work = tempfile.mkdtemp(prefix="truortho-ablation-")
     t0 = time.perf_counter()
     try:
+        started = acceptance_commit()
         rows = [run_scene(i, args.seed, work, lambda m: print(m, flush=True)) for i in indices]
     finally:
         shutil.rmtree(work, ignore_errors=True)
-    _, _, head = acceptance.run_header("acceptance_ablation.py", argv)
+    _, _, head = acceptance.run_header("acceptance_ablation.py", argv, started=started)
     head += f"; {len(rows)} scenes, master seed {args.seed}, {(time.perf_counter() - t0) / 60:.1f} min"
     text = "\n".join([head, "", *tables(rows), ""])
     print("\n" + text)
