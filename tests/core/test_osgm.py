@@ -528,9 +528,10 @@ def test_edge_visibility_march_starts_beyond_the_band_it_redecides():
 
 
 def test_edge_decision_takes_wall_heights_and_holes_outright():
-    """Side decision (core/osgm/edges.py): a height half way up a wall or a hole takes the better side
-    outright; a height on one side moves only on clear evidence (RATIO); nothing is decided without a
-    pair of views on each side or sides less than a step apart."""
+    """Side decision (core/osgm/edges.py): a hole, or a height half way up a wall that is less
+    consistent than a side, takes the better side outright; a height on one side moves only on clear
+    evidence (RATIO); nothing is decided without a pair of views on each side or sides less than a
+    step apart."""
     from truortho.core.osgm.edges import RATIO, _decide
 
     step = 1.0
@@ -541,13 +542,19 @@ def test_edge_decision_takes_wall_heights_and_holes_outright():
     c_hi = np.array([0.99 * RATIO, 0.9, 0.9, 0.5, 0.1, 0.1, 0.5])  # the high side's cost; low's is 1
     cost = np.stack([np.ones(7), c_hi])
     npairs = np.array([[3, 3, 3, 3, 0, 3, 3], [3, 3, 3, 3, 3, 3, 3]])
-    side, switch, fill = _decide(zc, np.stack([lo, hi]), mid, cost, npairs, step)
+    own = np.full(7, np.inf)
+    own[2] = 0.95  # the cost at cell 2's own height (it lies between the sides)
+    side, switch, fill = _decide(zc, np.stack([lo, hi]), mid, cost, npairs, step, own)
     # 0: ground, the roof clearly better -> switches; 1: not clear enough -> stays;
-    # 2: wall height, roof a bit better -> takes the roof; 3: hole -> roof;
+    # 2: wall height, the roof more consistent than it -> takes the roof; 3: hole -> roof;
     # 4: no pair on the low side -> undecided; 5: sides 0.5 apart -> no step; 6: on the roof side
     assert switch.tolist() == [True, False, False, False, False, False, False]
     assert fill.tolist() == [False, False, True, True, False, False, False]
     assert side[2] == 1 and side[3] == 1 and side[6] == 1
+    # a height between the sides that is itself the most consistent (a crown's flank) stays
+    own[2] = 0.5
+    side, switch, fill = _decide(zc, np.stack([lo, hi]), mid, cost, npairs, step, own)
+    assert not fill[2] and not switch[2]
 
 
 def test_edge_consistency_outvotes_one_occluded_view():
