@@ -61,12 +61,22 @@ def shown_argv(argv: list[str], drop: tuple[str, ...] = ()) -> list[str]:
     return [a for a in out if not a.startswith("--keep=") and a not in drop]
 
 
-def header(command: str, peers: dict[str, str] | None = None) -> str:
-    """The line above a section: command, commit, date, machine, peers."""
+def measured_commit(started: str | None) -> str:
+    """The commit a run measured: ``started`` (:func:`commit` when it started) if given, with a
+    remark when HEAD moved during the run; else :func:`commit` now."""
+    now = commit()
+    if started is None or started == now:
+        return now
+    return f"{started} (HEAD moved to {now} during the run)"
+
+
+def header(command: str, peers: dict[str, str] | None = None, started: str | None = None) -> str:
+    """The line above a section: command, commit (``started``: see :func:`measured_commit`),
+    date, machine, peers."""
     load = load_average()
     peer = "; peers: " + ", ".join(f"{k} {v}" for k, v in peers.items()) if peers else ""
     return (
-        f"Command: `{command}` at commit {commit()}, {datetime.date.today().isoformat()}, "
+        f"Command: `{command}` at commit {measured_commit(started)}, {datetime.date.today().isoformat()}, "
         f"{platform.machine()} {os.cpu_count()} cores{load}{peer}."
     )
 

@@ -536,13 +536,9 @@ def run_header(script: str, argv, detail: str = "", started: str | None = None) 
     """
     cmd = f"python -P bench/{script} " + " ".join(argv if argv is not None else sys.argv[1:])
     sys.path.insert(0, HERE)
-    from _docs import commit as head_commit
-    from _docs import load_average
+    from _docs import load_average, measured_commit
 
-    now = head_commit()
-    commit = started or now
-    if started and now != started:
-        commit = f"{started} (HEAD moved to {now} during the run)"
+    commit = measured_commit(started)
 
     head = (f"`{cmd.strip()}` on {commit or '?'}, {datetime.date.today()}, {platform.machine()} "
             f"{os.cpu_count()} cores{load_average()}" + (f", {detail}" if detail else ""))  # fmt: skip

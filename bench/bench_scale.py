@@ -360,6 +360,10 @@ def main(argv=None) -> int:
         print(msg, flush=True)
 
     rows = []
+    sys.path.insert(0, HERE)
+    from _docs import commit as head_commit
+
+    started = head_commit()  # the code measured: taken before the run, not after it
     base = args.keep or tempfile.mkdtemp(prefix="truortho-scale-")
     try:
         # every block is rendered first, then the pipelines run one after the other: the measured
@@ -421,7 +425,7 @@ def main(argv=None) -> int:
         mp = f"{args.megapixels:g}"
         key, title = ("scale", "Scale: photos to true ortho") if mp == "12" else (
             f"scale-{mp}mp", f"Scale at {mp} MP: photos to true ortho")
-        write_section(key, title, [header(cmd), "", *lines])
+        write_section(key, title, [header(cmd, started=started), "", *lines])
     return 0
 
 

@@ -225,13 +225,16 @@ def main(argv=None) -> int:
         if b not in BLOCKS:
             raise SystemExit(f"--blocks: unknown block {b!r} (expected {', '.join(BLOCKS)})")
     work = args.keep or tempfile.mkdtemp(prefix="truortho-real-")
+    sys.path.insert(0, HERE)
+    from _docs import commit as head_commit
+    from _docs import measured_commit
+
+    started = head_commit()  # the code measured: taken before the run, not after it
     rows = [
         run_block(b, os.path.join(work, b), resolution_of(args.resolution, b), lambda m: print(m, flush=True))
         for b in names
     ]
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()  # fmt: skip
-    sys.path.insert(0, HERE)
+    commit = measured_commit(started)
     from _docs import load_average, shown_argv
 
     cmd = "python -P bench/real_blocks.py " + " ".join(shown_argv(argv if argv is not None else sys.argv[1:]))
