@@ -41,7 +41,8 @@ scene goes to ``bench/results/acceptance/scene_NN.jpg`` (hillshades of the truth
 true orthos on both).
 
 Then the distribution over the scenes (median, worst, share meeting the goal of issue 17) and
-the OSGM / SGBM time ratio. Results go to ``bench/results/acceptance.json``; ``--write-docs``
+the OSGM / SGBM time ratio. Results go to ``bench/results/acceptance.json`` (a run of some scenes,
+``--only``, to ``acceptance_only.json``: it does not replace the full run's); ``--write-docs``
 replaces the marked section of ``docs/acceptance.md`` with the table, the command, the commit
 and the machine.
 """
@@ -608,7 +609,8 @@ def main(argv=None) -> int:
     text = "\n".join([head, "", *summary(rows), "", *scene_table(rows), ""])
     print("\n" + text)
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
-    with open(os.path.join(HERE, "results", "acceptance.json"), "w") as fh:
+    name = "acceptance_only.json" if args.only else "acceptance.json"
+    with open(os.path.join(HERE, "results", name), "w") as fh:
         json.dump(
             {"command": cmd, "commit": commit, "seed": args.seed, "head": head, "rows": rows}, fh, indent=1
         )
