@@ -94,14 +94,34 @@ def _side_heights(z, rows_idx, cols_idx, w, lo_out, hi_out, mid_out):
         mid_out[n] = mid
 
 
+#: Cells per side of the blocks whose highest height lets the visibility march skip a block the ray
+#: passes above (a max-mipmap level): the march then costs per block, not per half cell.
+BLOCK = 8
+
+
+def block_max(z: np.ndarray, block: int = BLOCK) -> np.ndarray:
+    """Highest height of every ``block`` x ``block`` block of ``z`` (NaN ignored; -inf: none)."""
+    z = np.asarray(z, np.float64)
+    rows, cols = z.shape
+    br, bc = -(-rows // block), -(-cols // block)
+    pad = np.full((br * block, bc * block), -np.inf)
+    pad[:rows, :cols] = np.where(np.isfinite(z), z, -np.inf)
+    return pad.reshape(br, block, bc, block).max(axis=(1, 3))
+
+
 @pjit
-def _ray_free(z, rows_idx, cols_idx, zc, x0, y0, res, C, tol, ztop, near, out):
+def _ray_free(z, bmax, block, rows_idx, cols_idx, zc, x0, y0, res, C, tol, ztop, near, out):
     """Whether the ray from each cell centre at height ``zc[n]`` to ``C`` stays above ``z`` in the tile.
 
+    The march tests the cells under the points ``t = res (1 + k / 2)`` along the ray (``t``: the
+    horizontal distance), and skips the points of a block of ``bmax`` (:func:`block_max` of ``z``
+    with ``block``) that the ray enters above its highest height plus ``tol``: the ray rises, so
+    none of them can hide it (the result is the same as without skipping).
     ``ztop``: the tile's highest height; a ray above ``ztop + tol`` is free (the march stops there).
     ``near``: the march tests the heights from this distance (in cells, horizontally) on.
     """
     rows, cols = z.shape
+    side = block * res
     for n in prange(rows_idx.shape[0]):
         r = rows_idx[n]
         c = cols_idx[n]
@@ -117,23 +137,42 @@ def _ray_free(z, rows_idx, cols_idx, zc, x0, y0, res, C, tol, ztop, near, out):
             ux = dx / dist
             uy = dy / dist
             slope = dzr / dist
-            t = res
+            k = 0
             while True:
+                t = res * (1.0 + 0.5 * k)
                 px = x + ux * t
                 py = y + uy * t
                 cc = int(np.floor((px - x0) / res))
                 rr = int(np.floor((y0 - py) / res))
                 if rr < 0 or rr >= rows or cc < 0 or cc >= cols:
                     break
+                ray = h + slope * t
+                if ray > ztop + tol:
+                    break
+                bi = rr // block
+                bj = cc // block
+                if ray > bmax[bi, bj] + tol:
+                    # above the whole block from here on: resume at the first point past its exit
+                    tx = np.inf
+                    if ux > 0.0:
+                        tx = (x0 + (bj + 1) * side - x) / ux
+                    elif ux < 0.0:
+                        tx = (x0 + bj * side - x) / ux
+                    ty = np.inf
+                    if uy < 0.0:
+                        ty = (y0 - (bi + 1) * side - y) / uy
+                    elif uy > 0.0:
+                        ty = (y0 - bi * side - y) / uy
+                    t_exit = min(tx, ty) - 1e-6 * res
+                    k_exit = int(np.ceil((t_exit / res - 1.0) * 2.0))
+                    k = max(k + 1, k_exit)
+                    continue
                 if t > near * res and not (rr == r and cc == c):
                     zz = z[rr, cc]
-                    ray = h + slope * t
                     if zz == zz and zz > ray + tol:
                         free = False
                         break
-                if h + slope * t > ztop + tol:
-                    break
-                t += 0.5 * res
+                k += 1
         out[n] = free
 
 
@@ -194,8 +233,9 @@ def _between(zc, cand, step):
     return np.isfinite(zc) & (np.abs(zc - cand[0]) > step) & (np.abs(zc - cand[1]) > step)
 
 
-def _cost_at(zz, ri, ci, heights, images, stats, x0, y0, res, tol, ztop):
-    """Photo-consistency ``(cost, pairs)`` of the listed cells at ``heights`` (steps 3 and 4)."""
+def _cost_at(zz, bmax, ri, ci, heights, images, stats, x0, y0, res, tol, ztop):
+    """Photo-consistency ``(cost, pairs)`` of the listed cells at ``heights`` (steps 3 and 4);
+    ``bmax``: :func:`block_max` of the heights ``zz``."""
     n = ri.size
     dr, dc = np.meshgrid(np.arange(-1, 2), np.arange(-1, 2), indexing="ij")
     dr, dc = dr.ravel(), dc.ravel()
@@ -212,7 +252,7 @@ def _cost_at(zz, ri, ci, heights, images, stats, x0, y0, res, tol, ztop):
     for v, img in enumerate(images):
         free = np.empty(n, np.bool_)
         C = np.asarray(img.view.C, np.float64)
-        _ray_free(zz, ri, ci, h, x0, y0, res, C, tol, ztop, float(NEAR), free)
+        _ray_free(zz, bmax, BLOCK, ri, ci, h, x0, y0, res, C, tol, ztop, float(NEAR), free)
         visible[v] = free
         mu, sd = stats[v]
         samples[v] = ((_samples(img, P) - mu) / sd).reshape(n, 9)
@@ -300,19 +340,20 @@ def refine_edges(
         mid = np.empty(n)
         zz = z.astype(np.float64)
         ztop = float(np.nanmax(zz))
+        bmax = block_max(zz)
         _side_heights(zz, ri, ci, REACH + 2, lo, hi, mid)
         cand = np.stack([lo, hi])  # (2, n)
         cost = np.full((2, n), np.inf)
         npairs = np.zeros((2, n), np.int64)
         for k in range(2):
-            cost[k], npairs[k] = _cost_at(zz, ri, ci, cand[k], images, stats, x0, y0, res, tol, ztop)
+            cost[k], npairs[k] = _cost_at(zz, bmax, ri, ci, cand[k], images, stats, x0, y0, res, tol, ztop)
         zc = z[ri, ci].astype(np.float64)
         # a height between the sides competes with them at its own height
         own = np.full(n, np.inf)
         between = _between(zc, cand, step)
         if between.any():
             b = np.nonzero(between)[0]
-            own[b] = _cost_at(zz, ri[b], ci[b], zc[b], images, stats, x0, y0, res, tol, ztop)[0]
+            own[b] = _cost_at(zz, bmax, ri[b], ci[b], zc[b], images, stats, x0, y0, res, tol, ztop)[0]
         idx = np.arange(n)
         side, switch, fill = _decide(zc, cand, mid, cost, npairs, step, own)
         other = 1 - side
