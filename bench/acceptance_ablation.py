@@ -40,7 +40,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 
 import acceptance  # noqa: E402
-from _docs import commit as acceptance_commit  # noqa: E402
+from _docs import commit as head_commit  # noqa: E402
 
 #: (name, SceneConfig changes)
 VARIANTS = (
@@ -137,7 +137,7 @@ def main(argv=None) -> int:
     work = tempfile.mkdtemp(prefix="truortho-ablation-")
     t0 = time.perf_counter()
     try:
-        started = acceptance_commit()
+        started = head_commit()  # the code measured: taken before the run
         rows = [run_scene(i, args.seed, work, lambda m: print(m, flush=True)) for i in indices]
     finally:
         shutil.rmtree(work, ignore_errors=True)

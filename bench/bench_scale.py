@@ -180,7 +180,6 @@ def render_block(n_images: int, megapixels: float, seed: int, folder: str, log) 
 
     cfg = block_config(n_images, megapixels, seed)
     images = os.path.join(folder, "images")
-    os.makedirs(images, exist_ok=True)
     rng = np.random.default_rng([seed, 181])
     sigma = float(rng.uniform(2.0, 5.0))
     to_wgs = Transformer.from_crs(cfg.crs, "EPSG:4326", always_xy=True)
@@ -198,7 +197,8 @@ def render_block(n_images: int, megapixels: float, seed: int, folder: str, log) 
             same = json.load(fh) == key
     if not same:
         shutil.rmtree(images, ignore_errors=True)
-        os.makedirs(images)
+    os.makedirs(images, exist_ok=True)  # and the block's folder, where render.partial.json goes
+    if not same:
         with open(partial, "w") as fh:
             json.dump(key, fh)
     kept = []

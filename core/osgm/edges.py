@@ -102,6 +102,10 @@ BLOCK = 8
 def block_max(z: np.ndarray, block: int = BLOCK) -> np.ndarray:
     """Highest height of every ``block`` x ``block`` block of ``z`` (NaN ignored; -inf: none)."""
     z = np.asarray(z, np.float64)
+    if z.ndim != 2:
+        raise InputError(f"block_max: expected 2-D heights, got shape {z.shape}")
+    if isinstance(block, bool) or not isinstance(block, int | np.integer) or block < 1:
+        raise InputError(f"block_max: block must be an integer >= 1, got {block!r}")
     rows, cols = z.shape
     br, bc = -(-rows // block), -(-cols // block)
     pad = np.full((br * block, bc * block), -np.inf)
@@ -356,15 +360,14 @@ def refine_edges(
             own[b] = _cost_at(zz, bmax, ri[b], ci[b], zc[b], images, stats, x0, y0, res, tol, ztop)[0]
         idx = np.arange(n)
         side, switch, fill = _decide(zc, cand, mid, cost, npairs, step, own)
-        other = 1 - side
-        own_c, oth_c = cost[side, idx], cost[other, idx]
         if not (switch.any() or fill.any()):
             break
-        z[ri[switch], ci[switch]] = cand[other[switch], idx[switch]].astype(np.float32)
+        z[ri[switch], ci[switch]] = cand[1 - side[switch], idx[switch]].astype(np.float32)
         z[ri[fill], ci[fill]] = cand[side[fill], idx[fill]].astype(np.float32)
         if conf is not None and fill.any():
             # the margin between the sides: 0 for a tie, 1 for a side no worse than perfect
-            margin = 1.0 - own_c[fill] / np.maximum(oth_c[fill], 1e-12)
+            taken, left = cost[side[fill], idx[fill]], cost[1 - side[fill], idx[fill]]
+            margin = 1.0 - taken / np.maximum(left, 1e-12)
             conf[ri[fill], ci[fill]] = np.clip(margin, 0.0, 1.0).astype(conf.dtype)
         moved = np.zeros(z.shape, np.uint8)
         moved[ri[switch], ci[switch]] = 1

@@ -603,6 +603,10 @@ def test_edge_visibility_march_skips_blocks_without_changing_the_answer():
         assert out.tolist() == want
         hidden += int((~out).sum())
     assert 200 < hidden < 12 * 400 - 200  # both answers are exercised
+    with pytest.raises(InputError, match="2-D heights"):
+        block_max(z.ravel())
+    with pytest.raises(InputError, match="block must be an integer >= 1"):
+        block_max(z, 0)
 
 
 def test_edge_consistency_outvotes_one_occluded_view():
