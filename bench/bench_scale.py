@@ -26,6 +26,14 @@ megapixels), which saves the rendering (about 11 s per 12 MP photo). With
 ``--write-docs`` the table goes into ``docs/benchmarks.md`` between the
 ``scale`` markers (``scale-<MP>mp`` for photos of other than 12 MP), with
 the command, the commit and the machine.
+
+Beside the synthetic blocks the bench runs the real **copr** block in full (41 photos of
+2136 x 1424 px from ``../shared/data/copr``, its GCPs, two check points; ``--copr auto``: when
+the data is there) through the same ``truortho:pipeline`` at ``--copr-resolution`` (0.05 m), and
+pycolmap's incremental pipeline on the same photos at the same working size in the same run
+(:mod:`bench_orientation`): the copr goals of issue 18 (photos to true ortho in 5 minutes, 4 GB;
+orientation in half pycolmap's time) are printed under the table. ``--sizes none`` with
+``--copr yes`` runs copr alone (its own ``scale-copr`` section).
 """
 
 from __future__ import annotations
@@ -52,6 +60,13 @@ SENSOR_WIDTH_MM = 13.2
 FLYING_HEIGHT = 100.0
 #: Buildings per square metre of block.
 BUILDING_DENSITY = 1.0 / 700.0
+#: The real block run beside the synthetic ones (issue 18: "copr in full, orientation against
+#: pycolmap in the same run"): 41 photos of 2136 x 1424 px with hand-held GNSS targets.
+COPR = os.path.join(os.path.dirname(ROOT), "shared", "data", "copr")
+#: Its check points (the other targets are GCPs), as in bench/real_blocks.py.
+COPR_CHECKS = ["gcp06", "gcp08"]
+#: Working size of the features, ours (the pipeline's default) and pycolmap's alike.
+WORKING_SIZE = 2000
 
 
 def image_size(megapixels: float) -> tuple[int, int]:
@@ -245,8 +260,13 @@ def render_block(n_images: int, megapixels: float, seed: int, folder: str, log) 
     }
 
 
-def run_pipeline(folder: str, checks: list[str], resolution: float, log) -> dict:
-    gcps = os.path.join(folder, "gcp_list.txt")
+def run_pipeline(
+    folder: str, checks: list[str], resolution: float, log, images: str = "", gcp_list: str = ""
+) -> dict:
+    """``truortho:importgcps`` and ``truortho:pipeline`` on ``images`` (default ``folder/images``)
+    with ``gcp_list`` (default ``folder/gcp_list.txt``); products, GeoPackages and log in ``folder``."""
+    gcps = gcp_list or os.path.join(folder, "gcp_list.txt")
+    images = images or os.path.join(folder, "images")
     imp = [QP, "run", "truortho:importgcps", "--", f"INPUT={gcps}", f"GCPS={folder}/gcps.gpkg",
            f"OBSERVATIONS={folder}/obs.gpkg"]  # fmt: skip
     if checks:
@@ -255,7 +275,7 @@ def run_pipeline(folder: str, checks: list[str], resolution: float, log) -> dict
     if p.returncode:
         raise SystemExit(f"importgcps failed:\n{p.stdout[-1500:]}\n{p.stderr[-1500:]}")
     products = os.path.join(folder, "products")
-    args = [f"IMAGES={folder}/images", f"GCPS={folder}/gcps.gpkg", f"OBSERVATIONS={folder}/obs.gpkg",
+    args = [f"IMAGES={images}", f"GCPS={folder}/gcps.gpkg", f"OBSERVATIONS={folder}/obs.gpkg",
             f"RESOLUTION={resolution}", f"OUTPUT_FOLDER={products}"]  # fmt: skip
     sys.path.insert(0, HERE)
     from real_blocks import picture, qgis_pipeline
@@ -331,6 +351,80 @@ def table(rows: list[dict]) -> list[str]:
     return out
 
 
+def run_copr(folder: str, resolution: float, log) -> dict:
+    """copr through ``truortho:pipeline`` (cold feature cache, like the synthetic blocks), then
+    pycolmap's incremental pipeline on the same photos at the same working size
+    (:func:`bench_orientation.run_engine_subprocess`, 2 threads, exhaustive matching)."""
+    images = os.path.join(COPR, "images")
+    if not os.path.isdir(images):
+        raise SystemExit(f"--copr: image folder {images} not found")
+    os.makedirs(folder, exist_ok=True)
+    shutil.rmtree(os.path.join(folder, "products"), ignore_errors=True)
+    photos = len([f for f in os.listdir(images) if f.lower().endswith((".jpg", ".jpeg"))])
+    log(f"copr: truortho:pipeline on {photos} photos at RESOLUTION {resolution}")
+    run = run_pipeline(
+        folder, COPR_CHECKS, resolution, log, images=images, gcp_list=os.path.join(COPR, "gcp_list.txt")
+    )
+    row = {"photos": photos, "resolution": resolution, "run": run}
+    try:
+        import pycolmap
+    except ImportError as err:  # the bench says so rather than failing
+        log(f"copr: pycolmap not available ({err}): no orientation comparison")
+        return row
+    sys.path.insert(0, HERE)
+    from bench_orientation import run_engine_subprocess
+
+    log(f"copr: pycolmap {pycolmap.__version__} on the same photos (working size {WORKING_SIZE} px)")
+    res = run_engine_subprocess("pycolmap", "copr", WORKING_SIZE, timeout=4 * 3600)
+    if "error" in res:
+        log(f"  pycolmap failed: {res['error']}")
+    row["pycolmap"] = {
+        "engine": res.get("engine", f"pycolmap {pycolmap.__version__}"),
+        "wall_s": res.get("wall_s"),
+        "peak_mb": res.get("peak_rss_mb"),
+        "registered": res.get("registered"),
+        "error": res.get("error"),
+    }
+    return row
+
+
+def copr_table(r: dict) -> list[str]:
+    """The copr row: the pipeline's stages, the goals (<= 5 min, <= 4 GB) and the orientation
+    against pycolmap's (goal <= 0.5)."""
+    st = {s[0]: s for s in r["run"]["stages"]}
+    wall = r["run"]["wall_s"]
+    peak = r["run"].get("peak_mb")
+    ours = st.get("orientation", [None, float("nan")])[1]
+    summ = r["run"].get("summary", {})
+    out = [
+        "| block | photos | RESOLUTION [m] | oriented | pipeline [s] | peak [MB] | "
+        + " | ".join(f"{n} [s]" for n in st)
+        + " |",
+        "|" + "---|" * (6 + len(st)),
+        "| copr | "
+        + " | ".join(
+            [str(r["photos"]), f"{r['resolution']:g}", str(summ.get("registered images", "?")),
+             f"{wall:.0f}", f"{peak:.0f}" if peak is not None else "?"]  # fmt: skip
+            + [f"{st[n][1]:.0f}" for n in st]
+        )
+        + " |",
+        "",
+        f"Photos to true ortho: {wall:.0f} s (goal <= 300 s), peak {peak} MB (goal <= 4096 MB).",
+    ]
+    pc = r.get("pycolmap")
+    if pc and pc.get("wall_s"):
+        out.append(
+            f"Orientation against {pc['engine']} in the same run (features, matching, reconstruction; "
+            f"{WORKING_SIZE} px, 2 threads): ours {ours:.0f} s (the pipeline's orientation stage, with "
+            f"its GCPs), pycolmap {pc['wall_s']:.0f} s ({pc.get('registered')} of {r['photos']} "
+            f"registered, peak {pc.get('peak_mb') or float('nan'):.0f} MB): ratio "
+            f"{ours / pc['wall_s']:.2f} (goal <= 0.5)."
+        )
+    elif pc:
+        out.append(f"pycolmap failed: {pc.get('error')}")
+    return out
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="50,100,200,400", help="comma-separated photo counts")
@@ -348,18 +442,30 @@ def main(argv=None) -> int:
         action="store_true",
         help="with --keep: render the blocks (render.json) and stop; a later --reuse run measures them",
     )
+    ap.add_argument(
+        "--copr",
+        choices=("auto", "yes", "no"),
+        default="auto",
+        help="also run the real copr block (41 photos) and pycolmap on it; auto: when its data is there",
+    )
+    ap.add_argument(
+        "--copr-resolution", type=float, default=0.05, help="RESOLUTION of the copr run (m; 0 = the GSD)"
+    )
     ap.add_argument("--write-docs", action="store_true", help=f"update the scale section of {DOCS}")
     args = ap.parse_args(argv)
     if args.render_only and (not args.keep or args.write_docs):
         raise SystemExit("--render-only: needs --keep DIR (where the blocks stay) and no --write-docs")
-    sizes = [int(s) for s in args.sizes.split(",") if s.strip()]
-    if not sizes or min(sizes) < 6:
-        raise SystemExit("--sizes: expected photo counts of at least 6")
+    spec = "" if args.sizes.strip().lower() == "none" else args.sizes
+    sizes = [int(s) for s in spec.split(",") if s.strip()]
+    copr = args.copr == "yes" or (args.copr == "auto" and os.path.isdir(COPR) and not args.render_only)
+    if (not sizes and not copr) or (sizes and min(sizes) < 6):
+        raise SystemExit('--sizes: expected photo counts of at least 6 (or "none", with --copr yes)')
 
     def log(msg: str) -> None:
         print(msg, flush=True)
 
     rows = []
+    copr_row = None
     sys.path.insert(0, HERE)
     from _docs import commit as head_commit
 
@@ -407,14 +513,17 @@ def main(argv=None) -> int:
             rows.append(info)
             if not args.keep:
                 shutil.rmtree(folder, ignore_errors=True)
+        copr_row = run_copr(os.path.join(base, "copr"), args.copr_resolution, log) if copr else None
     finally:
         if not args.keep:
             shutil.rmtree(base, ignore_errors=True)
-    lines = table(rows)
+    lines = table(rows) if rows else []
+    if copr_row is not None:
+        lines += ([""] if lines else []) + copr_table(copr_row)
     print("\n".join(lines))
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
     with open(os.path.join(HERE, "results", "scale.json"), "w") as fh:
-        json.dump(rows, fh, indent=1)
+        json.dump({"blocks": rows, "copr": copr_row}, fh, indent=1)
     if args.write_docs:
         sys.path.insert(0, HERE)
         from _docs import header, shown_argv, write_section
@@ -425,6 +534,8 @@ def main(argv=None) -> int:
         mp = f"{args.megapixels:g}"
         key, title = ("scale", "Scale: photos to true ortho") if mp == "12" else (
             f"scale-{mp}mp", f"Scale at {mp} MP: photos to true ortho")
+        if not rows:
+            key, title = "scale-copr", "Scale: copr in full, against pycolmap"
         write_section(key, title, [header(cmd, started=started), "", *lines])
     return 0
 
