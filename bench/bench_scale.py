@@ -34,6 +34,11 @@ pycolmap's incremental pipeline on the same photos at the same working size in t
 (:mod:`bench_orientation`): the copr goals of issue 18 (photos to true ortho in 5 minutes, 4 GB;
 orientation in half pycolmap's time) are printed under the table. ``--sizes none`` with
 ``--copr yes`` runs copr alone (its own ``scale-copr`` section).
+
+``--add-rows FILE`` joins the blocks of an earlier run's ``scale.json`` to this run's table, if
+the product code (:data:`PRODUCT_PATHS`), megapixels and resolution are the same; the table says
+which rows came from which run. It lets a long rendering run between the measurements of two
+blocks without either competing with it.
 """
 
 from __future__ import annotations
@@ -425,6 +430,35 @@ def copr_table(r: dict) -> list[str]:
     return out
 
 
+#: What the products depend on: an earlier run's rows join a table only if these are unchanged.
+PRODUCT_PATHS = ("core", "processing", "truortho_plugin", "metadata.txt")
+
+
+def load_rows(path: str, started: str, megapixels: float, resolution: float) -> dict:
+    """An earlier run's ``scale.json`` whose rows may join this run's table: same megapixels and
+    resolution, and no change to :data:`PRODUCT_PATHS` between its commit and this one."""
+    try:
+        with open(path) as fh:
+            earlier = json.load(fh)
+    except (OSError, ValueError) as err:
+        raise SystemExit(f"--add-rows: cannot read {path}: {err}") from err
+    if not isinstance(earlier, dict) or "commit" not in earlier or not earlier.get("blocks"):
+        raise SystemExit(f"--add-rows: {path} is not a scale.json with a commit and blocks")
+    if (earlier.get("megapixels"), earlier.get("resolution")) != (megapixels, resolution):
+        raise SystemExit(
+            f"--add-rows: {path} measured {earlier.get('megapixels')} MP at RESOLUTION "
+            f"{earlier.get('resolution')}, this run {megapixels} MP at {resolution}"
+        )
+    a, b = str(earlier["commit"]), started
+    if "+dirty" in a or "+dirty" in b or a == "unknown" or b == "unknown":
+        raise SystemExit(f"--add-rows: both runs must be of committed code (got {a} and {b})")
+    diff = subprocess.run(["git", "-C", ROOT, "diff", "--quiet", a, b, "--", *PRODUCT_PATHS])
+    if diff.returncode != 0:
+        changed = ", ".join(PRODUCT_PATHS)
+        raise SystemExit(f"--add-rows: the product code ({changed}) changed between {a} and {b}")
+    return earlier
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="50,100,200,400", help="comma-separated photo counts")
@@ -451,6 +485,12 @@ def main(argv=None) -> int:
     ap.add_argument(
         "--copr-resolution", type=float, default=0.05, help="RESOLUTION of the copr run (m; 0 = the GSD)"
     )
+    ap.add_argument(
+        "--add-rows",
+        default="",
+        help="a scale.json of an earlier run of the same product code, megapixels and resolution: "
+        "its blocks join this run's table (named as such under it)",
+    )
     ap.add_argument("--write-docs", action="store_true", help=f"update the scale section of {DOCS}")
     args = ap.parse_args(argv)
     if args.render_only and (not args.keep or args.write_docs):
@@ -470,6 +510,7 @@ def main(argv=None) -> int:
     from _docs import commit as head_commit
 
     started = head_commit()  # the code measured: taken before the run, not after it
+    earlier = load_rows(args.add_rows, started, args.megapixels, args.resolution) if args.add_rows else None
     base = args.keep or tempfile.mkdtemp(prefix="truortho-scale-")
     try:
         # every block is rendered first, then the pipelines run one after the other: the measured
@@ -517,13 +558,30 @@ def main(argv=None) -> int:
     finally:
         if not args.keep:
             shutil.rmtree(base, ignore_errors=True)
+    result = {
+        "commit": started,
+        "date": time.strftime("%Y-%m-%d %H:%M"),
+        "megapixels": args.megapixels,
+        "resolution": args.resolution,
+        "blocks": list(rows),
+        "copr": copr_row,
+    }
+    if earlier is not None:
+        rows = sorted(earlier["blocks"] + rows, key=lambda r: r["photos"])
     lines = table(rows) if rows else []
+    if earlier is not None:
+        named = ", ".join(str(r["photos"]) for r in earlier["blocks"])
+        lines.append(
+            f"The row(s) of {named} photos come from an earlier run of the same product code "
+            f"(commit {earlier['commit']}, {earlier['date']}; `--add-rows`): the machine was kept idle "
+            "for each run, and the blocks were run apart to fit the rendering between them."
+        )
     if copr_row is not None:
         lines += ([""] if lines else []) + copr_table(copr_row)
     print("\n".join(lines))
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
     with open(os.path.join(HERE, "results", "scale.json"), "w") as fh:
-        json.dump({"blocks": rows, "copr": copr_row}, fh, indent=1)
+        json.dump(result, fh, indent=1)
     if args.write_docs:
         sys.path.insert(0, HERE)
         from _docs import header, shown_argv, write_section
