@@ -414,7 +414,9 @@ def copr_table(r: dict) -> list[str]:
         )
         + " |",
         "",
-        f"Photos to true ortho: {wall:.0f} s (goal <= 300 s), peak {peak} MB (goal <= 4096 MB).",
+        f"Photos to true ortho: {wall:.0f} s (goal <= 300 s), peak "
+        + (f"{peak:.0f}" if peak is not None else "?")
+        + " MB (goal <= 4096 MB).",
     ]
     pc = r.get("pycolmap")
     if pc and pc.get("wall_s"):
@@ -567,14 +569,20 @@ def main(argv=None) -> int:
         "copr": copr_row,
     }
     if earlier is not None:
+        # a block measured again in this run keeps this run's row (checked here: the photo counts
+        # are known only once the blocks are rendered)
+        mine = {r["photos"] for r in rows}
+        dropped = sorted(r["photos"] for r in earlier["blocks"] if r["photos"] in mine)
+        if dropped:
+            log(f"--add-rows: this run measured {dropped} photos again; its rows replace the earlier ones")
+        earlier["blocks"] = [r for r in earlier["blocks"] if r["photos"] not in mine]
         rows = sorted(earlier["blocks"] + rows, key=lambda r: r["photos"])
     lines = table(rows) if rows else []
-    if earlier is not None:
+    if earlier is not None and earlier["blocks"]:
         named = ", ".join(str(r["photos"]) for r in earlier["blocks"])
         lines.append(
             f"The row(s) of {named} photos come from an earlier run of the same product code "
-            f"(commit {earlier['commit']}, {earlier['date']}; `--add-rows`): the machine was kept idle "
-            "for each run, and the blocks were run apart to fit the rendering between them."
+            f"(commit {earlier['commit']}, {earlier['date']}; `--add-rows`)."
         )
     if copr_row is not None:
         lines += ([""] if lines else []) + copr_table(copr_row)
