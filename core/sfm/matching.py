@@ -9,13 +9,20 @@ first set's descriptor is also the nearest neighbour of its match (mutual
 nearest neighbours). :func:`match_pairs` runs that and the robust two-view
 geometry (:mod:`.twoview`) over a list of image pairs.
 
-The cost of a pair grows with the product of the two feature counts, yet only the features
-in the images' common part can match. :func:`match_pairs` therefore first matches the
-largest ``overlap_features`` of each image, fits a homography to them with a loose
-threshold, and matches only the features that fall inside the other image's frame mapped
-through it (grown by ``overlap_margin`` for relief): :func:`overlap_rows`. Pairs where that
-fails (few coarse matches, a scene too 3-D for one homography, little to save) are matched
-whole, as before.
+The cost of a pair grows with the product of the two feature counts, yet a feature can only
+match near where the other image sees the same ground. :func:`match_pairs` therefore first
+matches the largest ``overlap_features`` of each image and fits a homography to them with a
+loose threshold (:func:`find_overlap`). Each feature of the first image is then compared only
+with the features of the second that lie within a window about its mapped position
+(:func:`match_windowed`): the window's radius is ``window_factor`` times the 95th percentile
+of the coarse matches' distances to the homography (the parallax of the relief and the
+homography's error, measured on the pair itself), between ``window_min`` and
+``overlap_margin`` of the image's larger side. On the 12 MP scale block that is about 1 % of
+the whole product, and more pairs' true matches pass the ratio test, which meets fewer
+look-alikes. Pairs whose coarse pass finds fewer than ``overlap_min_coarse`` matches are taken
+as not overlapping and not matched further (on that block such pairs never verified, and
+matched whole they were three quarters of the matching time); pairs where the coarse pass finds
+matches but no homography (a scene too 3-D for one) are matched whole, as before.
 """
 
 from __future__ import annotations
@@ -63,8 +70,18 @@ class MatchConfig:
     #: overlap (:func:`overlap_rows`); 0 matches every feature against every other.
     overlap_features: int = 1500
     #: Margin around the other image's frame, mapped by the coarse homography, as a share of
-    #: that image's larger side (parallax of relief and off-plane objects, obliques).
+    #: that image's larger side (parallax of relief and off-plane objects, obliques); also the
+    #: largest window radius of :func:`match_windowed`.
     overlap_margin: float = 0.15
+    #: Window radius of :func:`match_windowed` as a multiple of the 95th percentile of the coarse
+    #: matches' distances to the homography; 0 searches the whole overlap (no windows).
+    window_factor: float = 3.0
+    #: Smallest window radius, as a share of the other image's larger side.
+    window_min: float = 0.02
+    #: :func:`match_pairs`: a pair whose coarse pass finds fewer matches is taken as not
+    #: overlapping and is not matched whole (0: every pair without a homography is matched whole).
+    #: Unrelated views find a few chance matches; a verified pair needs ``min_inliers`` (20).
+    overlap_min_coarse: int = 12
 
     def validate(self) -> None:
         if not (isinstance(self.ratio, int | float) and 0 < self.ratio <= 1):
@@ -75,10 +92,16 @@ class MatchConfig:
             v = getattr(self, n)
             if not isinstance(v, int | np.integer) or v < 1:
                 raise InputError(f"{n} must be a positive integer, got {v!r}")
-        if not isinstance(self.overlap_features, int | np.integer) or self.overlap_features < 0:
-            raise InputError(f"overlap_features must be an integer >= 0, got {self.overlap_features!r}")
+        for n in ("overlap_features", "overlap_min_coarse"):
+            v = getattr(self, n)
+            if not isinstance(v, int | np.integer) or v < 0:
+                raise InputError(f"{n} must be an integer >= 0, got {v!r}")
         if not (isinstance(self.overlap_margin, int | float) and 0 <= self.overlap_margin <= 10):
             raise InputError(f"overlap_margin must be in [0, 10], got {self.overlap_margin!r}")
+        if not (isinstance(self.window_factor, int | float) and 0 <= self.window_factor <= 100):
+            raise InputError(f"window_factor must be in [0, 100], got {self.window_factor!r}")
+        if not (isinstance(self.window_min, int | float) and 0 < self.window_min <= 10):
+            raise InputError(f"window_min must be in (0, 10], got {self.window_min!r}")
 
 
 @fastjit
@@ -231,76 +254,241 @@ def _inside(xy: np.ndarray, H: np.ndarray, width: int, height: int, margin: floa
         return ok & (u >= -margin) & (u <= width + margin) & (v >= -margin) & (v <= height + margin)
 
 
-def overlap_rows(fi: Features, fj: Features, config: MatchConfig | None = None):
-    """Rows of the features of two images that can lie in their common part, or None.
+@dataclass
+class Overlap:
+    """Where two images overlap, from :func:`find_overlap` (full-resolution pixels).
 
-    A coarse pass matches the ``overlap_features`` largest features of each image and fits a
-    homography to them with a loose threshold (3 % of the diagonal): the images' frames mapped
-    through it, grown by ``overlap_margin``, bound where matches can be. Returns
-    ``(rows_i, rows_j)`` (increasing) of the features inside the other image's mapped frame,
-    or None when the pair should be matched whole: too few features or coarse matches, a
-    homography that explains less than :data:`OVERLAP_MIN_INLIER_SHARE` of them (strong relief,
-    close range), a frame that maps across the horizon, or a saving under
-    :data:`OVERLAP_MIN_SAVING`. Deterministic (seeded).
+    Attributes
+    ----------
+    H : (3, 3)
+        Homography from the first image to the second, fitted to the coarse matches.
+    rows_i, rows_j : (N,) int64
+        Features of each image inside the other's frame mapped through ``H``, grown by
+        ``overlap_margin`` (increasing).
+    residual_q95 : float
+        95th percentile of the coarse inliers' distances to ``H`` in the second image, pixels.
     """
-    import cv2
 
+    H: np.ndarray
+    rows_i: np.ndarray
+    rows_j: np.ndarray
+    residual_q95: float
+
+
+def find_overlap(fi: Features, fj: Features, config: MatchConfig | None = None) -> Overlap | None:
+    """The homography and common part of two images from a coarse pass, or None.
+
+    The coarse pass matches the ``overlap_features`` largest features of each image and fits a
+    homography to them with a loose threshold (3 % of the diagonal). Returns None when the pair
+    should be matched whole: too few features or coarse matches, a homography that explains less
+    than :data:`OVERLAP_MIN_INLIER_SHARE` of them (strong relief, close range), or a frame that
+    maps across the horizon. Deterministic (seeded).
+    """
     cfg = config or MatchConfig()
     cfg.validate()
+    return _coarse(fi, fj, cfg)[0]
+
+
+def _coarse(fi: Features, fj: Features, cfg: MatchConfig) -> tuple[Overlap | None, int]:
+    """:func:`find_overlap`, and the number of coarse matches (-1: no coarse pass)."""
+    import cv2
+
     k = int(cfg.overlap_features)
     ni, nj = len(fi), len(fj)
     if k <= 0 or ni < 2 * k or nj < 2 * k:
-        return None
+        return None, -1
     # the largest features: they repeat across views far more often than the strongest (on the
     # 12 MP scale block the 1,500 largest of 8,000 found 30 % of a pair's matches, the strongest 5 %)
     ti = np.sort(np.argsort(-fi.size, kind="stable")[:k])
     tj = np.sort(np.argsort(-fj.size, kind="stable")[:k])
     m0, _ = match_descriptors(fi.descriptor_rows(ti), fj.descriptor_rows(tj), cfg)
-    if len(m0) < OVERLAP_MIN_MATCHES:
-        return None
+    nc = len(m0)
+    if nc < OVERLAP_MIN_MATCHES:
+        return None, nc
     p, q = fi.xy[ti[m0[:, 0]]], fj.xy[tj[m0[:, 1]]]
     diag = 0.5 * (math.hypot(fi.width, fi.height) + math.hypot(fj.width, fj.height))
     cv2.setRNGSeed(0)
     try:
         H, mask = cv2.findHomography(p, q, cv2.RANSAC, 0.03 * diag, maxIters=2000, confidence=0.999)
     except cv2.error:
-        return None
+        return None, nc
     if H is None or mask is None:
-        return None
-    n_in = int(mask.sum())
-    if n_in < OVERLAP_MIN_MATCHES or n_in < OVERLAP_MIN_INLIER_SHARE * len(m0):
-        return None
+        return None, nc
+    inl = mask.ravel().astype(bool)
+    n_in = int(inl.sum())
+    if n_in < OVERLAP_MIN_MATCHES or n_in < OVERLAP_MIN_INLIER_SHARE * nc:
+        return None, nc
     try:
         Hinv = np.linalg.inv(H)
     except np.linalg.LinAlgError:
-        return None
+        return None, nc
     corners_i = np.array([[0, 0], [fi.width, 0], [fi.width, fi.height], [0, fi.height]], float)
     corners_j = np.array([[0, 0], [fj.width, 0], [fj.width, fj.height], [0, fj.height]], float)
     for c, M in ((corners_i, H), (corners_j, Hinv)):
         if not np.all(np.column_stack([c, np.ones(4)]) @ M[2] > 1e-9):
-            return None  # a frame corner maps behind the other camera: no bounded overlap
+            return None, nc  # a frame corner maps behind the other camera: no bounded overlap
     ri = np.flatnonzero(_inside(fi.xy, H, fj.width, fj.height, cfg.overlap_margin * max(fj.width, fj.height)))
     rj = np.flatnonzero(
         _inside(fj.xy, Hinv, fi.width, fi.height, cfg.overlap_margin * max(fi.width, fi.height))
     )
-    if len(ri) * len(rj) > (1.0 - OVERLAP_MIN_SAVING) * ni * nj:
+    hp = np.column_stack([p[inl], np.ones(n_in)]) @ H.T
+    res = np.linalg.norm(hp[:, :2] / hp[:, 2:3] - q[inl], axis=1)
+    return Overlap(H, ri, rj, float(np.percentile(res, 95))), nc
+
+
+def overlap_rows(fi: Features, fj: Features, config: MatchConfig | None = None):
+    """Rows ``(rows_i, rows_j)`` of the features of two images that can lie in their common
+    part (:func:`find_overlap`), or None: no overlap found, or one that would save less than
+    :data:`OVERLAP_MIN_SAVING` of the whole product."""
+    ov = find_overlap(fi, fj, config)
+    if ov is None or len(ov.rows_i) * len(ov.rows_j) > (1.0 - OVERLAP_MIN_SAVING) * len(fi) * len(fj):
         return None
-    return ri, rj
+    return ov.rows_i, ov.rows_j
+
+
+@fastjit
+def _top2_window(dot, na, nb, rows, cand, best_i, best_d, col_best, col_arg):
+    """:func:`_top2_block` for the features ``rows`` of the first image against the candidates
+    ``cand`` of the second (``dot[r, c]`` their descriptor products); indices are global."""
+    for r in range(len(rows)):
+        i = rows[r]
+        d1 = np.inf
+        d2 = np.inf
+        j1 = -1
+        for c in range(len(cand)):
+            j = cand[c]
+            d = na[i] + nb[j] - 2.0 * dot[r, c]
+            if d < d2:
+                if d < d1:
+                    d2 = d1
+                    d1 = d
+                    j1 = j
+                else:
+                    d2 = d
+            if d < col_best[j]:
+                col_best[j] = d
+                col_arg[j] = i
+        best_i[i] = j1
+        best_d[i, 0] = d1
+        best_d[i, 1] = d2
+
+
+def match_windowed(fi: Features, fj: Features, H, radius: float, config: MatchConfig | None = None):
+    """Matches ``(M, 2)`` (sorted by the first index) of two images whose features are compared
+    only within ``radius`` pixels (full resolution, in the second image) of where ``H`` maps them.
+
+    The second image's frame, grown by ``radius``, is cut into square cells of at least
+    ``radius`` (and at least 1/16 of its larger side); a feature of the first image is compared
+    with the features of the 3 x 3 cells about the cell of its mapped position, a superset of its
+    window. Ratio test and mutual check as :func:`match_descriptors`, over those candidates: the
+    second-nearest neighbour and the back-match are searched among the features that could be
+    the same point.
+    """
+    cfg = config or MatchConfig()
+    empty = np.zeros((0, 2), np.int64)
+    if len(fi) < 1 or len(fj) < 2:
+        return empty
+    H = np.asarray(H, np.float64)
+    r = float(radius)
+    s = max(r, max(fj.width, fj.height) / 16.0, 1.0)
+    q = np.column_stack([fi.xy, np.ones(len(fi))]) @ H.T
+    ok = q[:, 2] > 1e-9
+    w = np.where(ok, q[:, 2], 1.0)
+    u, v = q[:, 0] / w, q[:, 1] / w
+    with np.errstate(invalid="ignore"):
+        ok &= (u >= -r) & (u <= fj.width + r) & (v >= -r) & (v <= fj.height + r)
+    ri = np.flatnonzero(ok)
+    nx = int(math.floor((fj.width + 2 * r) / s)) + 1
+    ny = int(math.floor((fj.height + 2 * r) / s)) + 1
+
+    def cell(x, y):
+        cx = np.clip(np.floor((x + r) / s).astype(np.int64), 0, nx - 1)
+        cy = np.clip(np.floor((y + r) / s).astype(np.int64), 0, ny - 1)
+        return cy * nx + cx
+
+    ci = cell(u[ri], v[ri])
+    cj = cell(fj.xy[:, 0], fj.xy[:, 1])
+    oi = ri[np.argsort(ci, kind="stable")]
+    ci = np.sort(ci, kind="stable")
+    oj = np.argsort(cj, kind="stable")
+    start_j = np.searchsorted(cj[oj], np.arange(nx * ny + 1))
+    a = fi.descriptors
+    b = fj.descriptors
+    na = np.einsum("ij,ij->i", a, a)
+    nb = np.einsum("ij,ij->i", b, b)
+    best_i = np.full(len(fi), -1, np.int64)
+    best_d = np.full((len(fi), 2), np.inf, np.float32)
+    col_best = np.full(len(fj), np.inf, np.float32)
+    col_arg = np.full(len(fj), -1, np.int64)
+    cells, first = np.unique(ci, return_index=True)
+    last = np.r_[first[1:], len(ci)]
+    for c, k0, k1 in zip(cells, first, last, strict=True):
+        cx, cy = int(c % nx), int(c // nx)
+        x0, x1 = max(cx - 1, 0), min(cx + 2, nx)
+        cand = np.concatenate(
+            [oj[start_j[y * nx + x0] : start_j[y * nx + x1]] for y in range(max(cy - 1, 0), min(cy + 2, ny))]
+        )
+        if len(cand) < 2:
+            continue
+        rows = oi[k0:k1]
+        _top2_window(_products(a[rows], b[cand]), na, nb, rows, cand, best_i, best_d, col_best, col_arg)
+    d = np.sqrt(np.maximum(best_d, 0.0))
+    i1 = np.flatnonzero((best_i >= 0) & (d[:, 0] < cfg.ratio * d[:, 1]))
+    i2 = best_i[i1]
+    if cfg.cross_check:
+        keep = col_arg[i2] == i1
+        i1, i2 = i1[keep], i2[keep]
+    if len(i1) == 0:
+        return empty
+    return np.column_stack([i1, i2]).astype(np.int64)
+
+
+def window_radius(ov: Overlap, fj: Features, config: MatchConfig) -> float:
+    """Search radius of :func:`match_windowed` for an overlap, pixels of the second image."""
+    side = max(fj.width, fj.height)
+    lo, hi = config.window_min * side, config.overlap_margin * side
+    return float(min(hi, max(lo, config.window_factor * ov.residual_q95)))
 
 
 def match_features(fi: Features, fj: Features, config: MatchConfig | None = None) -> tuple[np.ndarray, bool]:
     """Matches ``(M, 2)`` of two images' features (sorted by the first index), and whether
-    they were searched in the overlap that :func:`overlap_rows` found only."""
+    they were searched in the overlap that :func:`find_overlap` found only (windows about the
+    mapped positions, :func:`match_windowed`; or the whole overlap with ``window_factor`` 0).
+    Every pair without an overlap is matched whole (``overlap_min_coarse`` is
+    :func:`match_pairs`' rule)."""
     cfg = config or MatchConfig()
-    rows = overlap_rows(fi, fj, cfg)
+    cfg.validate()
+    m, restricted, _ = _match_pair(fi, fj, cfg, 0)
+    return m, restricted
+
+
+def _match_pair(
+    fi: Features, fj: Features, cfg: MatchConfig, min_coarse: int
+) -> tuple[np.ndarray, bool, int]:
+    """Matches, restricted or not, and the coarse matches (-1: no coarse pass); a pair with
+    fewer than ``min_coarse`` coarse matches gets no matches."""
+    if cfg.window_factor > 0:
+        ov, nc = _coarse(fi, fj, cfg)
+        if ov is not None:
+            return match_windowed(fi, fj, ov.H, window_radius(ov, fj, cfg), cfg), True, nc
+        rows = None
+    else:
+        ov, nc = _coarse(fi, fj, cfg)
+        rows = None
+        if ov is not None and len(ov.rows_i) * len(ov.rows_j) <= (1.0 - OVERLAP_MIN_SAVING) * len(fi) * len(
+            fj
+        ):
+            rows = ov.rows_i, ov.rows_j
     if rows is None:
+        if 0 <= nc < min_coarse:
+            return np.zeros((0, 2), np.int64), False, nc
         m, _ = match_descriptors(fi.descriptors, fj.descriptors, cfg)
-        return m, False
+        return m, False, nc
     ri, rj = rows
     m, _ = match_descriptors(fi.descriptor_rows(ri), fj.descriptor_rows(rj), cfg)
     if len(m):
         m = np.column_stack([ri[m[:, 0]], rj[m[:, 1]]])
-    return m, True
+    return m, True, nc
 
 
 @dataclass
@@ -325,8 +513,13 @@ class PairMatches:
     geometry: TwoViewResult
     seconds_matching: float
     seconds_geometry: float
-    #: Matched within the overlap a coarse pass found (:func:`overlap_rows`), not whole.
+    #: Matched within the overlap a coarse pass found (:func:`find_overlap`), not whole.
     restricted: bool = False
+    #: Matches of the coarse pass (-1: none ran).
+    coarse_matches: int = -1
+    #: The coarse pass found fewer than ``overlap_min_coarse`` matches: taken as not
+    #: overlapping, not matched further (no matches, ``geometry`` says why).
+    skipped: bool = False
 
     @property
     def ok(self) -> bool:
@@ -370,7 +563,8 @@ def match_pairs(
         One per pair, in the given order (failed pairs included, with their reason).
     stats : dict
         ``pairs``, ``verified``, ``seconds``, ``seconds_matching`` and
-        ``seconds_geometry`` (totals).
+        ``seconds_geometry`` (totals), ``overlap_restricted`` (pairs matched in the overlap
+        that a coarse pass found) and ``no_overlap`` (pairs taken as not overlapping).
     """
     mcfg = match_config or MatchConfig()
     mcfg.validate()
@@ -393,7 +587,8 @@ def match_pairs(
         i, j = int(pair[0]), int(pair[1])
         fi, fj = features[i], features[j]
         t = time.perf_counter()
-        m, restricted = match_features(fi, fj, mcfg)
+        m, restricted, nc = _match_pair(fi, fj, mcfg, int(mcfg.overlap_min_coarse))
+        skipped = not restricted and 0 <= nc < mcfg.overlap_min_coarse
         t1 = time.perf_counter()
         cam_i = cameras[i] if cameras is not None else None
         cam_j = cameras[j] if cameras is not None else None
@@ -406,7 +601,7 @@ def match_pairs(
             pixel_scale=1.0 / min(fi.scale, fj.scale),
             matches=m,
         )
-        return PairMatches(i, j, len(m), geo, t1 - t, time.perf_counter() - t1, restricted)
+        return PairMatches(i, j, len(m), geo, t1 - t, time.perf_counter() - t1, restricted, nc, skipped)
 
     for r in thread_map(one, P, threads, prog, lambda k, n: f"matching pair {k + 1} of {n}"):
         tm += r.seconds_matching
@@ -420,5 +615,6 @@ def match_pairs(
         "seconds_matching": tm,
         "seconds_geometry": tg,
         "overlap_restricted": sum(r.restricted for r in out),
+        "no_overlap": sum(r.skipped for r in out),
     }
     return out, stats

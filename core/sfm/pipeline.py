@@ -435,6 +435,14 @@ def second_pass_pairs(sel, missing, partners: int) -> list[tuple[int, int]]:
     return sorted(out)
 
 
+def skipped_pairs_of(results, missing) -> set[int]:
+    """Indices of the ``results`` (:class:`~.matching.PairMatches`) of pairs with an image in
+    ``missing`` that the coarse pass took as not overlapping (``skipped``): the second pass
+    matches them whole, since a left-out image may need exactly such a weak link."""
+    lost = {int(v) for v in missing}
+    return {k for k, r in enumerate(results) if r.skipped and (r.i in lost or r.j in lost)}
+
+
 def reconstruct_block(
     inputs: OrientInputs,
     matches: OrientMatches,
@@ -455,7 +463,7 @@ def reconstruct_block(
     InputError
         Fewer than two images registered.
     """
-    from .matching import match_pairs
+    from .matching import MatchConfig, match_pairs
     from .tracks import tracks_from_pairs
 
     paths, names, image_camera, cams = inputs.paths, inputs.names, inputs.image_camera, inputs.cams
@@ -500,12 +508,23 @@ def reconstruct_block(
     if len(missing) and may_retry and rec.registered.sum() >= 2:
         # second chance: match the images left out against every image not paired with them yet
         extra = second_pass_pairs(sel, missing, cfg.second_pass_partners)
+        # and, matched whole this time, their first-pass pairs that the coarse pass took as not
+        # overlapping (MatchConfig.overlap_min_coarse)
+        retry = skipped_pairs_of(results, missing)
+        extra = sorted(set(extra) | {(results[k].i, results[k].j) for k in retry})
+        results = [r for k, r in enumerate(results) if k not in retry]
     if extra:
         check(prog)
         parts[1].update(
             0.0, f"matching {len(missing)} unregistered image(s) against all others ({len(extra)} pairs)"
         )
-        more, _ = match_pairs(features, np.array(extra), matches.per_image_cams, progress=parts[1])
+        more, _ = match_pairs(
+            features,
+            np.array(extra),
+            matches.per_image_cams,
+            MatchConfig(overlap_min_coarse=0),
+            progress=parts[1],
+        )
         results = results + more
         n_verified = sum(r.ok for r in results)
         tracks = tracks_from_pairs(features, results, cell, cfg.min_pair_tracks)

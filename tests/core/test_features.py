@@ -308,6 +308,63 @@ def test_pairs_are_matched_in_their_overlap_only(tmp_path):
         MatchConfig(overlap_margin=-1).validate()
 
 
+def _synthetic_features(xy, sift, width=4000, height=3000):
+    from truortho.core.sfm.features import Features
+
+    n = len(xy)
+    return Features(
+        np.asarray(xy, float), np.full(n, 10.0, np.float32), np.zeros(n, np.float32),
+        np.ones(n, np.float32), np.asarray(sift, np.uint8), np.zeros((n, 3), np.uint8),
+        width, height, 0.5,
+    )  # fmt: skip
+
+
+def test_windowed_matching_searches_about_the_mapped_position():
+    """Each feature meets only the features near where the homography maps it: a look-alike
+    farther than the window (repetitive texture) no longer fails the ratio test, a point whose
+    parallax exceeds the window is not matched, and the result is the whole search's where the
+    window holds every true partner."""
+    from truortho.core.sfm.matching import match_windowed
+
+    rng = np.random.default_rng(3)
+    n = 3000
+    xy = np.column_stack([rng.uniform(0, 4000, n), rng.uniform(0, 3000, n)])
+    xy[:2] = [[800.0, 1000.0], [900.0, 2000.0]]
+    sift = rng.integers(0, 60, (n, 128))
+    H = np.array([[0.98, 0.03, 700.0], [-0.03, 0.98, -150.0], [1e-6, 2e-6, 1.0]])
+    q = np.column_stack([xy, np.ones(n)]) @ H.T
+    xy_j = q[:, :2] / q[:, 2:3] + rng.normal(0, 3.0, (n, 2))  # relief parallax of a few px
+    sift_j = np.clip(sift + rng.integers(-4, 5, (n, 128)), 0, 255)
+    # a twin of feature 0's partner 1,500 px away (repetitive facade), and point 1 off by 900 px
+    # (the 3 x 3 cells searched reach at most 2 cells of max(radius, 4000 / 16) px)
+    xy_j = np.vstack([xy_j, xy_j[0] + [1500.0, 0.0]])
+    sift_j = np.vstack([sift_j, np.clip(sift_j[0] + rng.integers(-1, 2, 128), 0, 255)])
+    xy_j[1] += [900.0, 0.0]
+    fi, fj = _synthetic_features(xy, sift), _synthetic_features(xy_j, sift_j)
+    inside = (xy_j[:n, 0] >= 0) & (xy_j[:n, 0] < 4000) & (xy_j[:n, 1] >= 0) & (xy_j[:n, 1] < 3000)
+    assert inside[0] and inside[1] and 1500 < inside.sum() < n
+
+    m = match_windowed(fi, fj, H, radius=60.0)
+    assert np.all(np.diff(m[:, 0]) > 0)
+    right = m[:, 0] == m[:, 1]
+    assert right.mean() > 0.999
+    found = set(m[right, 0])
+    assert 0 in found  # its twin lies outside the window
+    assert 1 not in found  # moved beyond the window
+    assert len(found) > 0.98 * (inside.sum() - 1)
+    whole, _ = match_descriptors(fi.descriptors, fj.descriptors)
+    assert 0 not in set(whole[:, 0])  # the whole search meets the twin: ratio test fails
+    true_whole = whole[(whole[:, 0] == whole[:, 1]) & inside[whole[:, 0]], 0]
+    assert set(true_whole) - {0, 1} <= found
+    # a radius larger than the frame is the whole search restricted to the mapped frame
+    m_all = match_windowed(fi, fj, H, radius=5000.0)
+    assert 0 not in set(m_all[:, 0]) and 1 in set(m_all[:, 0])
+    with pytest.raises(InputError, match="window_factor"):
+        MatchConfig(window_factor=-1).validate()
+    with pytest.raises(InputError, match="window_min"):
+        MatchConfig(window_min=0).validate()
+
+
 def test_two_view_inliers_do_not_depend_on_the_sample():
     """Nearly flat terrain (dunes, +-1 m at 60 m): the estimator's own inlier set depends on the
     sample it ends with; after refinement and re-selection every seed finds the same true inliers."""

@@ -133,3 +133,19 @@ def test_second_pass_pairs_are_bounded_and_nearest_first():
     assert len(second_pass_pairs(sel2, [150], 0)) == n - 1 - 4
     with pytest.raises(InputError, match="second_pass_partners"):
         second_pass_pairs(sel, [1], -1)
+
+
+def test_second_pass_retries_the_pairs_taken_as_not_overlapping():
+    """A left-out image's first-pass pairs that the coarse pass skipped are matched again (whole);
+    skipped pairs of registered images and matched pairs of the left-out image are not."""
+    from types import SimpleNamespace
+
+    from truortho.core.sfm.pipeline import skipped_pairs_of
+
+    def r(i, j, skipped):
+        return SimpleNamespace(i=i, j=j, skipped=skipped)
+
+    results = [r(0, 1, False), r(0, 5, True), r(1, 2, True), r(3, 5, False), r(2, 5, True)]
+    assert skipped_pairs_of(results, [5]) == {1, 4}
+    assert skipped_pairs_of(results, np.array([2, 5])) == {1, 2, 4}
+    assert skipped_pairs_of(results, []) == set()
