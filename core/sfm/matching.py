@@ -104,31 +104,6 @@ class MatchConfig:
             raise InputError(f"window_min must be in (0, 10], got {self.window_min!r}")
 
 
-@fastjit
-def _top2_block(dot, na, nb, row0, best_i, best_d, col_best, col_arg):
-    """Two smallest squared distances per row of a block; smallest per column so far."""
-    m, n = dot.shape
-    for r in range(m):
-        d1 = np.inf
-        d2 = np.inf
-        j1 = -1
-        for c in range(n):
-            d = na[row0 + r] + nb[c] - 2.0 * dot[r, c]
-            if d < d2:
-                if d < d1:
-                    d2 = d1
-                    d1 = d
-                    j1 = c
-                else:
-                    d2 = d
-            if d < col_best[c]:
-                col_best[c] = d
-                col_arg[c] = row0 + r
-        best_i[row0 + r] = j1
-        best_d[row0 + r, 0] = d1
-        best_d[row0 + r, 1] = d2
-
-
 def _products(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """``a @ b.T`` (float32, C order) through SciPy's Fortran BLAS.
 
@@ -153,10 +128,24 @@ def _brute_force(a: np.ndarray, b: np.ndarray, block: int = 1024):
     best_d = np.empty((len(a), 2), np.float32)
     col_best = np.full(len(b), np.inf, np.float32)
     col_arg = np.full(len(b), -1, np.int64)
+    cols = np.arange(len(b), dtype=np.int64)
     for r0 in range(0, len(a), block):
-        _top2_block(_products(a[r0 : r0 + block], b), na, nb, r0, best_i, best_d, col_best, col_arg)
+        rows = np.arange(r0, min(r0 + block, len(a)), dtype=np.int64)
+        _top2_window(_products(a[r0 : r0 + block], b), na, nb, rows, cols, best_i, best_d, col_best, col_arg)
     d = np.sqrt(np.maximum(best_d, 0.0))
     return best_i, d, col_arg
+
+
+def _ratio_and_mutual(best, dist, back, cfg: MatchConfig) -> tuple[np.ndarray, np.ndarray]:
+    """Rows ``i1`` and their matches ``i2`` that pass the ratio test (``dist`` (N, 2): nearest
+    and second-nearest distances of each row, ``best`` the nearest's index, -1 when none) and,
+    with ``cross_check``, the mutual check (``back``: the nearest row of each column)."""
+    i1 = np.flatnonzero((best >= 0) & (dist[:, 0] < cfg.ratio * dist[:, 1]))
+    i2 = best[i1]
+    if cfg.cross_check:
+        keep = back[i2] == i1
+        i1, i2 = i1[keep], i2[keep]
+    return i1, i2
 
 
 def _matcher(cfg: MatchConfig):
@@ -210,11 +199,7 @@ def match_descriptors(d1, d2, config: MatchConfig | None = None) -> tuple[np.nda
     use_bf = cfg.method == "bf" or (cfg.method == "auto" and max(len(a), len(b)) <= cfg.bf_max)
     if use_bf:
         best, dist, back = _brute_force(a, b)
-        i1 = np.flatnonzero((best >= 0) & (dist[:, 0] < cfg.ratio * dist[:, 1]))
-        i2 = best[i1]
-        if cfg.cross_check:
-            keep = back[i2] == i1
-            i1, i2 = i1[keep], i2[keep]
+        i1, i2 = _ratio_and_mutual(best, dist, back, cfg)
         if len(i1) == 0:
             return empty
         return np.column_stack([i1, i2]).astype(np.int64), dist[i1, 0]
@@ -348,8 +333,9 @@ def overlap_rows(fi: Features, fj: Features, config: MatchConfig | None = None):
 
 @fastjit
 def _top2_window(dot, na, nb, rows, cand, best_i, best_d, col_best, col_arg):
-    """:func:`_top2_block` for the features ``rows`` of the first image against the candidates
-    ``cand`` of the second (``dot[r, c]`` their descriptor products); indices are global."""
+    """Two smallest squared distances (``na + nb - 2 dot``) of each of the features ``rows`` of
+    the first image among the candidates ``cand`` of the second (``dot[r, c]`` their descriptor
+    products), and the smallest so far of each candidate; indices are global."""
     for r in range(len(rows)):
         i = rows[r]
         d1 = np.inf
@@ -432,12 +418,7 @@ def match_windowed(fi: Features, fj: Features, H, radius: float, config: MatchCo
             continue
         rows = oi[k0:k1]
         _top2_window(_products(a[rows], b[cand]), na, nb, rows, cand, best_i, best_d, col_best, col_arg)
-    d = np.sqrt(np.maximum(best_d, 0.0))
-    i1 = np.flatnonzero((best_i >= 0) & (d[:, 0] < cfg.ratio * d[:, 1]))
-    i2 = best_i[i1]
-    if cfg.cross_check:
-        keep = col_arg[i2] == i1
-        i1, i2 = i1[keep], i2[keep]
+    i1, i2 = _ratio_and_mutual(best_i, np.sqrt(np.maximum(best_d, 0.0)), col_arg, cfg)
     if len(i1) == 0:
         return empty
     return np.column_stack([i1, i2]).astype(np.int64)
