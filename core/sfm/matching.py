@@ -326,9 +326,14 @@ def overlap_rows(fi: Features, fj: Features, config: MatchConfig | None = None):
     part (:func:`find_overlap`), or None: no overlap found, or one that would save less than
     :data:`OVERLAP_MIN_SAVING` of the whole product."""
     ov = find_overlap(fi, fj, config)
-    if ov is None or len(ov.rows_i) * len(ov.rows_j) > (1.0 - OVERLAP_MIN_SAVING) * len(fi) * len(fj):
+    if ov is None or not _saves_enough(ov, fi, fj):
         return None
     return ov.rows_i, ov.rows_j
+
+
+def _saves_enough(ov: Overlap, fi: Features, fj: Features) -> bool:
+    """Whether matching only the overlap's rows saves :data:`OVERLAP_MIN_SAVING` of the product."""
+    return len(ov.rows_i) * len(ov.rows_j) <= (1.0 - OVERLAP_MIN_SAVING) * len(fi) * len(fj)
 
 
 @fastjit
@@ -371,11 +376,16 @@ def match_windowed(fi: Features, fj: Features, H, radius: float, config: MatchCo
     the same point.
     """
     cfg = config or MatchConfig()
+    cfg.validate()
+    H = np.asarray(H, np.float64)
+    if H.shape != (3, 3) or not np.all(np.isfinite(H)):
+        raise InputError(f"match_windowed: H must be a finite 3x3 homography, got shape {H.shape}")
+    r = float(radius)
+    if not (math.isfinite(r) and r >= 0):
+        raise InputError(f"match_windowed: radius must be a finite number of pixels >= 0, got {radius!r}")
     empty = np.zeros((0, 2), np.int64)
     if len(fi) < 1 or len(fj) < 2:
         return empty
-    H = np.asarray(H, np.float64)
-    r = float(radius)
     s = max(r, max(fj.width, fj.height) / 16.0, 1.0)
     q = np.column_stack([fi.xy, np.ones(len(fi))]) @ H.T
     ok = q[:, 2] > 1e-9
@@ -439,37 +449,29 @@ def match_features(fi: Features, fj: Features, config: MatchConfig | None = None
     :func:`match_pairs`' rule)."""
     cfg = config or MatchConfig()
     cfg.validate()
-    m, restricted, _ = _match_pair(fi, fj, cfg, 0)
+    m, restricted, _, _ = _match_pair(fi, fj, cfg, 0)
     return m, restricted
 
 
 def _match_pair(
     fi: Features, fj: Features, cfg: MatchConfig, min_coarse: int
-) -> tuple[np.ndarray, bool, int]:
-    """Matches, restricted or not, and the coarse matches (-1: no coarse pass); a pair with
-    fewer than ``min_coarse`` coarse matches gets no matches."""
-    if cfg.window_factor > 0:
-        ov, nc = _coarse(fi, fj, cfg)
-        if ov is not None:
-            return match_windowed(fi, fj, ov.H, window_radius(ov, fj, cfg), cfg), True, nc
-        rows = None
-    else:
-        ov, nc = _coarse(fi, fj, cfg)
-        rows = None
-        if ov is not None and len(ov.rows_i) * len(ov.rows_j) <= (1.0 - OVERLAP_MIN_SAVING) * len(fi) * len(
-            fj
-        ):
-            rows = ov.rows_i, ov.rows_j
-    if rows is None:
-        if 0 <= nc < min_coarse:
-            return np.zeros((0, 2), np.int64), False, nc
-        m, _ = match_descriptors(fi.descriptors, fj.descriptors, cfg)
-        return m, False, nc
-    ri, rj = rows
-    m, _ = match_descriptors(fi.descriptor_rows(ri), fj.descriptor_rows(rj), cfg)
-    if len(m):
-        m = np.column_stack([ri[m[:, 0]], rj[m[:, 1]]])
-    return m, True, nc
+) -> tuple[np.ndarray, bool, int, bool]:
+    """Matches; whether they were searched in the overlap only; the coarse matches (-1: no coarse
+    pass); and whether the pair was skipped (fewer than ``min_coarse`` coarse matches and no
+    overlap found: no matches)."""
+    ov, nc = _coarse(fi, fj, cfg)
+    if ov is not None and cfg.window_factor > 0:
+        return match_windowed(fi, fj, ov.H, window_radius(ov, fj, cfg), cfg), True, nc, False
+    if ov is not None and _saves_enough(ov, fi, fj):
+        ri, rj = ov.rows_i, ov.rows_j
+        m, _ = match_descriptors(fi.descriptor_rows(ri), fj.descriptor_rows(rj), cfg)
+        if len(m):
+            m = np.column_stack([ri[m[:, 0]], rj[m[:, 1]]])
+        return m, True, nc, False
+    if 0 <= nc < min_coarse:
+        return np.zeros((0, 2), np.int64), False, nc, True
+    m, _ = match_descriptors(fi.descriptors, fj.descriptors, cfg)
+    return m, False, nc, False
 
 
 @dataclass
@@ -568,8 +570,7 @@ def match_pairs(
         i, j = int(pair[0]), int(pair[1])
         fi, fj = features[i], features[j]
         t = time.perf_counter()
-        m, restricted, nc = _match_pair(fi, fj, mcfg, int(mcfg.overlap_min_coarse))
-        skipped = not restricted and 0 <= nc < mcfg.overlap_min_coarse
+        m, restricted, nc, skipped = _match_pair(fi, fj, mcfg, int(mcfg.overlap_min_coarse))
         t1 = time.perf_counter()
         cam_i = cameras[i] if cameras is not None else None
         cam_j = cameras[j] if cameras is not None else None
