@@ -17,6 +17,7 @@ from truortho.core.orientation import GCP
 from truortho.core.sfm.georef import (
     GeorefConfig,
     block_from_reconstruction,
+    bowl_misfit,
     control_sigma_scale,
     georeference,
 )
@@ -38,6 +39,32 @@ def test_sigma_scale_from_the_misfit():
     assert scale[0] == pytest.approx(misfit / 0.02) and scale[1] == 1.0
     assert len(notes) == 1 and "in plan" in notes[0] and f"{misfit:.3f} m" in notes[0]
     assert control_sigma_scale(fitted[:2], surveyed[:2], stated[:2])[0].tolist() == [1.0, 1.0]
+
+
+def test_a_bowl_in_height_keeps_the_stated_sigma():
+    """A nadir block adjusted from its photos alone is bent into a bowl; control that differs from
+    it by a bowl is right, and relaxing it would keep the bowl (the 406-photo scale block: check
+    heights 17 GSD off). Random height errors of the same size are still relaxed."""
+    rng = np.random.default_rng(5)
+    surveyed = np.column_stack([rng.uniform(0, 700, (9, 2)), rng.uniform(-3, 3, 9)])
+    stated = np.tile([0.02, 0.02, 0.03], (9, 1))
+    r2 = ((surveyed[:, :2] - [350.0, 350.0]) ** 2).sum(1)
+    bowl = 1.8 - 2.5 * r2 / r2.max()
+    fitted = surveyed + np.column_stack([rng.normal(0, 0.02, (9, 2)), bowl + rng.normal(0, 0.03, 9)])
+    rest, amplitude = bowl_misfit(surveyed[:, :2], fitted[:, 2] - surveyed[:, 2])
+    assert rest < 0.06 and 2.0 < amplitude < 3.0, (rest, amplitude)
+    scale, notes = control_sigma_scale(fitted, surveyed, stated)
+    assert scale.tolist() == [1.0, 1.0]
+    assert len(notes) == 1 and "a bowl of" in notes[0], notes
+    # the same size of misfit, not smooth: relaxed
+    noisy = surveyed.copy()
+    noisy[:, 2] += rng.permutation(bowl - bowl.mean())
+    scale, notes = control_sigma_scale(noisy, surveyed, stated)
+    assert scale[1] > 10 and "so that the control does not bend the block" in notes[0], (scale, notes)
+    # too few points to tell a bowl from errors: relaxed as before
+    scale, _ = control_sigma_scale(fitted[:6], surveyed[:6], stated[:6])
+    assert scale[1] > 10
+    assert np.isnan(bowl_misfit(surveyed[:6, :2], bowl[:6])[0])
 
 
 def _tilt_deg(rotations):

@@ -149,3 +149,29 @@ def test_second_pass_retries_the_pairs_taken_as_not_overlapping():
     assert skipped_pairs_of(results, [5]) == {1, 4}
     assert skipped_pairs_of(results, np.array([2, 5])) == {1, 2, 4}
     assert skipped_pairs_of(results, []) == set()
+
+
+def test_second_pass_plan_matches_new_partners_as_the_first_pass_and_skipped_pairs_whole():
+    """The second pass: a left-out image's new partners (nearest first, not tried yet), its
+    first-pass pairs that the coarse pass skipped (to be matched whole), and the first-pass results
+    kept without those."""
+    from types import SimpleNamespace
+
+    from truortho.core.sfm.pipeline import second_pass_plan
+
+    xy = np.array([[0.0, 0], [10, 0], [20, 0], [30, 0], [40, 0], [50, 0]])
+    sel = SimpleNamespace(n_images=6, pairs=np.array([[0, 1], [1, 2], [3, 4], [4, 5], [3, 5]]),
+                          details={"local_xy": xy})  # fmt: skip
+    results = [
+        SimpleNamespace(i=0, j=1, skipped=False),
+        SimpleNamespace(i=1, j=2, skipped=False),
+        SimpleNamespace(i=3, j=4, skipped=False),
+        SimpleNamespace(i=4, j=5, skipped=False),
+        SimpleNamespace(i=3, j=5, skipped=True),
+    ]
+    new, whole, kept = second_pass_plan(sel, results, [5], partners=2)
+    assert sorted(new) == [(1, 5), (2, 5)], new  # the two nearest not tried yet (4 was)
+    assert whole == [(3, 5)]
+    assert [(r.i, r.j) for r in kept] == [(0, 1), (1, 2), (3, 4), (4, 5)]
+    new, whole, kept = second_pass_plan(sel, results, [0], partners=0)
+    assert sorted(new) == [(0, 2), (0, 3), (0, 4), (0, 5)] and whole == [] and kept == results
