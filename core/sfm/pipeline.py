@@ -853,7 +853,13 @@ def _adjust_free(block: Block, gcfg: GeorefConfig):
         refine_intrinsics=gcfg.refine_intrinsics,
     )
     res = bundle_adjust(
-        pb, BundleConfig(max_iterations=gcfg.max_iterations, loss="huber", loss_scale=gcfg.loss_scale_px)
+        pb,
+        BundleConfig(
+            max_iterations=gcfg.max_iterations,
+            loss="huber",
+            loss_scale=gcfg.loss_scale_px,
+            function_tolerance=gcfg.function_tolerance,
+        ),
     )
     block.rotations, block.centers, block.points = res.rotations, res.centers, res.points
     for c, cam in enumerate(block.cameras):
