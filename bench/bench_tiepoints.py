@@ -246,7 +246,7 @@ def run_synthetic(block: Block, working_size: int) -> dict:
         roles = {g.name: g.role for g in scene.orientation.gcps}
         for g in gcps:
             g.role = roles[g.name]
-        paths = sorted(str(p) for p in folder.glob("img_*.png"))
+        paths = sorted(str(folder / im.name) for im in scene.orientation.images)  # PNG, or JPEG files
         runs = []
         for refine in (False, True):
             r = _orient(paths, gcps, crs, refine, working_size, 8000, folder / f"work{int(refine)}")

@@ -33,7 +33,11 @@ from .views import TileViews
 
 class ImageStore:
     """Decoded images by (index, level) with an LRU cache of at most ``max_bytes``; rasters that
-    rasterio reads (GeoTIFF) are read by windows instead (:meth:`source`)."""
+    rasterio reads (GeoTIFF) are read by windows instead (:meth:`source`).
+
+    ``chroma`` (optional, one entry per image): the colour subsampling of a JPEG whose colour
+    :func:`~truortho.core.chroma.restore_chroma` restores at full resolution (level 0), or None.
+    """
 
     def __init__(
         self,
@@ -43,8 +47,12 @@ class ImageStore:
         dtype,
         max_bytes: int = 1 << 30,
         windowed: bool = True,
+        chroma: list | None = None,
     ) -> None:
         self.paths = paths
+        if chroma is not None and len(chroma) != len(paths):
+            raise InputError(f"ImageStore: {len(chroma)} chroma entries for {len(paths)} images")
+        self.chroma = list(chroma) if chroma is not None else [None] * len(paths)
         self.sizes = sizes
         self.bands = int(bands)
         self.dtype = np.dtype(dtype)
@@ -106,6 +114,12 @@ class ImageStore:
         decodes JPEGs directly at the reduced scale)."""
         img = read_image_level(self.paths[i], self.sizes[i], level)
         self._check(i, img)
+        sub = self.chroma[i]
+        if level == 0 and sub is not None and img.dtype == np.uint8 and img.ndim == 3 and img.shape[2] == 3:
+            # from level 1 on a pixel averages 2 x 2 or more: the colour is about as sharp as the luma
+            from ..chroma import restore_chroma
+
+            img = restore_chroma(img, sub)
         with self._lock:
             self.reads += 1
         return np.ascontiguousarray(img)

@@ -134,6 +134,11 @@ class TrueOrthoConfig:
         always use every image.
     image_cache_mb : int
         Bound of the decoded-image cache.
+    restore_chroma : bool
+        JPEG images whose colour is stored at a lower resolution than their brightness (4:2:0 or
+        4:2:2, read from the file header) get their colour edges restored from the brightness
+        before they are sampled at full resolution (:mod:`truortho.core.chroma`): without it the
+        decoder's smeared colour paints roof colours beside every outline.
     color_cells : int
         Cells of the decimated grid used to estimate the colour correction.
     workers : int
@@ -193,6 +198,7 @@ class TrueOrthoConfig:
     views_per_cell: int = 0
     top_views: int = 8
     image_cache_mb: int = 1024
+    restore_chroma: bool = True
     color_cells: int = 60_000
     workers: int = 2
     cog: bool = True
@@ -650,7 +656,12 @@ def ortho_candidates(
         if not _has_zstd():
             raise InputError("compression: this GDAL cannot write ZSTD; use 'deflate' or 'lzw'")
     sizes = [(c.width, c.height) for c in setup.cameras]
-    store = ImageStore(paths, sizes, bands, dtype, cfg.image_cache_mb << 20)
+    chroma = None
+    if cfg.restore_chroma and dtype == np.uint8 and bands == 3:
+        from ..chroma import jpeg_chroma_subsampling
+
+        chroma = [jpeg_chroma_subsampling(p) for p in paths]
+    store = ImageStore(paths, sizes, bands, dtype, cfg.image_cache_mb << 20, chroma=chroma)
     return OrthoCandidates(setup, relevant, paths, sizes, bands, dtype, store)
 
 
@@ -730,6 +741,7 @@ def run_mosaic(
         None,  # the colour correction, set below
         params,
         workers,
+        chroma=tuple(store.chroma) if store is not None else (),
         store=store,
     )
     in_process = isinstance(executor, InProcessExecutor) or (executor is None and cfg.executor == "inprocess")

@@ -69,6 +69,8 @@ class OrthoContext:
     correction: ColorCorrection | None
     params: MosaicParams
     workers: int
+    #: per image, the JPEG colour subsampling the store restores (:class:`~.mosaic.ImageStore`)
+    chroma: tuple = ()
     #: the run's own image store, used in this process; never pickled (workers open their own)
     store: ImageStore | None = field(default=None, compare=False)
     #: visibility computed ahead in this process (:class:`ViewPrefetch`); never pickled
@@ -81,7 +83,7 @@ class OrthoContext:
         return state
 
     def store_key(self) -> tuple:
-        return (self.paths, self.sizes, int(self.bands), str(self.dtype), int(self.cache_bytes))
+        return (self.paths, self.sizes, int(self.bands), str(self.dtype), int(self.cache_bytes), self.chroma)
 
 
 @dataclass
@@ -104,7 +106,10 @@ def worker_store(ctx: OrthoContext) -> ImageStore:
         return ctx.store
     return _STORES.get(
         ctx.store_key(),
-        lambda: ImageStore(list(ctx.paths), list(ctx.sizes), ctx.bands, np.dtype(ctx.dtype), ctx.cache_bytes),
+        lambda: ImageStore(
+            list(ctx.paths), list(ctx.sizes), ctx.bands, np.dtype(ctx.dtype), ctx.cache_bytes,
+            chroma=list(ctx.chroma) or None,
+        ),
     )
 
 

@@ -334,10 +334,17 @@ def _radiometry(colour, cx, cy, corner, strength, gain, offset, noise, noisy, ou
 
 def jpeg_roundtrip(image: np.ndarray, quality: int) -> np.ndarray:
     """``image`` (H, W, 3) uint8 RGB encoded as a JPEG at ``quality`` and decoded (0: unchanged)."""
+    return jpeg_file(image, quality)[0]
+
+
+def jpeg_file(image: np.ndarray, quality: int) -> tuple[np.ndarray, bytes | None]:
+    """``(decoded, file)``: ``image`` (H, W, 3) uint8 RGB encoded as a JPEG file at ``quality``
+    (OpenCV's encoder: 4:2:0 colour, as most cameras store it), and that file decoded; 0: the image
+    unchanged and no file."""
     if isinstance(quality, bool) or not isinstance(quality, int | np.integer) or not 0 <= quality <= 100:
         raise InputError(f"jpeg_roundtrip: quality must be an integer in [0, 100], got {quality!r}")
     if not quality:
-        return image
+        return image, None
     if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 3:
         raise InputError(
             f"jpeg_roundtrip: expected an (H, W, 3) uint8 image, got {image.dtype} {image.shape}"
@@ -349,7 +356,7 @@ def jpeg_roundtrip(image: np.ndarray, quality: int) -> np.ndarray:
     )
     if not ok:
         raise InputError("jpeg_roundtrip: the JPEG encoder failed")
-    return np.ascontiguousarray(cv2.imdecode(buf, cv2.IMREAD_COLOR)[:, :, ::-1])
+    return np.ascontiguousarray(cv2.imdecode(buf, cv2.IMREAD_COLOR)[:, :, ::-1]), buf.tobytes()
 
 
 def random_radiometry(

@@ -30,6 +30,7 @@ from .raycast import cast_rays
 from .render import (
     Radiometry,
     apply_radiometry,
+    jpeg_file,
     jpeg_roundtrip,
     random_radiometry,
     render_colour,
@@ -63,7 +64,11 @@ class SyntheticScene:
     orientation : Orientation
         Exact cameras (one :class:`Camera`), images ``img_000.png``... and GCPs.
     images : list of (H, W, 3) uint8
-        Rendered RGB images, with per-image radiometry.
+        Rendered RGB images, with per-image radiometry (and, with ``config.jpeg_quality``, the
+        JPEG round trip).
+    jpeg_files : list of bytes
+        With ``config.jpeg_quality``: the images' JPEG files, which :meth:`write` stores as they
+        are (the images are named ``img_NNN.jpg`` then); empty otherwise.
     radiometry : list of Radiometry
         The exposure truth of every image.
     n_nadir : int
@@ -83,6 +88,7 @@ class SyntheticScene:
     tex: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(4))
     sun: np.ndarray = field(repr=False, default_factory=lambda: np.zeros(4))
     _rays: dict = field(repr=False, default_factory=dict)
+    jpeg_files: list = field(repr=False, default_factory=list)
 
     # ---------------------------------------------------------- access
     @property
@@ -204,7 +210,8 @@ class SyntheticScene:
     def write(self, folder: str | os.PathLike, resolution: float | None = None) -> Path:
         """Write the data set to ``folder`` (created if needed).
 
-        Files: ``img_NNN.png`` (RGB), ``orientation.json`` (image root = the
+        Files: ``img_NNN.png`` (RGB; ``img_NNN.jpg``, the JPEG files themselves, with
+        ``config.jpeg_quality``), ``orientation.json`` (image root = the
         folder), ``gcp_list.txt`` (ODM: ``EPSG:...`` then
         ``X Y Z px py image name`` in world coordinates, pixel centres as in
         TruOrtho/OpenSfM), ``dsm.tif`` (float32, nodata -9999) and
@@ -216,11 +223,17 @@ class SyntheticScene:
 
         out = Path(folder)
         out.mkdir(parents=True, exist_ok=True)
-        for im, img in zip(self.orientation.images, self.images, strict=True):
-            ok, buf = cv2.imencode(".png", np.ascontiguousarray(img[:, :, ::-1]))
-            if not ok:
-                raise InputError(f"could not encode {im.name}")
-            _atomic_write_bytes(out / (im.path or im.name), buf.tobytes())
+        if self.jpeg_files and len(self.jpeg_files) != len(self.images):
+            raise InputError(f"write: {len(self.jpeg_files)} JPEG files for {len(self.images)} images")
+        for k, (im, img) in enumerate(zip(self.orientation.images, self.images, strict=True)):
+            if self.jpeg_files:
+                data = self.jpeg_files[k]
+            else:
+                ok, buf = cv2.imencode(".png", np.ascontiguousarray(img[:, :, ::-1]))
+                if not ok:
+                    raise InputError(f"could not encode {im.name}")
+                data = buf.tobytes()
+            _atomic_write_bytes(out / (im.path or im.name), data)
         o = dataclasses.replace(self.orientation, image_root=str(out.resolve()))
         o.save(out / "orientation.json")
         lines = [self.config.crs]
@@ -312,6 +325,10 @@ def make_scene(
         images += oblique_cameras(((x0 + x1) / 2, (y0 + y1) / 2, cfg.ground_height), cam, cfg.flying_height,
                                   cfg.n_oblique, cfg.oblique_tilt_deg, 0.0, cfg.attitude_sigma_deg / 2,
                                   cfg.position_sigma / 2, cfg.seed, first_index=n_nadir)
+    if cfg.jpeg_quality:
+        # the images are JPEG files, as a camera writes them (write() stores their bytes)
+        jpg = [os.path.splitext(im.name)[0] + ".jpg" for im in images]
+        images = [dataclasses.replace(im, name=n, path=n) for im, n in zip(images, jpg, strict=True)]
     meta = {"synthetic": {"seed": cfg.seed, "n_nadir": n_nadir, "n_oblique": len(images) - n_nadir}}
     frame = LocalFrame(cfg.crs, np.asarray(cfg.offset, dtype=np.float64))
     orientation = Orientation(frame, {cam.id: cam}, images, None, [], ".", meta)
@@ -335,9 +352,11 @@ def make_scene(
             continue
         colour, _, _, _ = render_colour(surface, scene.palette, scene.tex, im.R, im.C, scene._subpixel(1),
                                         sub, cfg.adaptive_supersampling, sun)
-        rgb = jpeg_roundtrip(apply_radiometry(colour, cam, rad), cfg.jpeg_quality)
+        rgb, jpeg = jpeg_file(apply_radiometry(colour, cam, rad), cfg.jpeg_quality)
         if image_sink is None:
             scene.images.append(rgb)
+            if jpeg is not None:
+                scene.jpeg_files.append(jpeg)
         else:
             image_sink(k, im, rgb)
         progress.update(0.95 * (k + 1) / len(images), f"rendered {im.name}")

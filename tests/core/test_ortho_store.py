@@ -78,3 +78,29 @@ def test_the_cache_stays_within_its_bound(monkeypatch):
         store.get(i)
     assert len(store._cache) == 2 and store._bytes <= store.max_bytes and store.reads == 5
     assert list(store._cache) == [(3, 0), (4, 0)]
+
+
+def test_subsampled_jpeg_colour_is_restored_at_full_resolution_only(tmp_path):
+    import cv2
+
+    from truortho.core.chroma import jpeg_chroma_subsampling, restore_chroma
+    from truortho.core.errors import InputError
+
+    rng = np.random.default_rng(7)
+    rgb = np.zeros((48, 64, 3), np.uint8)
+    rgb[:] = (90, 110, 80)
+    rgb[10:30, 12:40] = (230, 30, 40)  # a red roof on grey-green ground
+    rgb = np.clip(rgb + rng.normal(0, 4, rgb.shape), 0, 255).astype(np.uint8)
+    path = tmp_path / "a.jpg"
+    path.write_bytes(cv2.imencode(".jpg", rgb[:, :, ::-1], [cv2.IMWRITE_JPEG_QUALITY, 92])[1].tobytes())
+    sub = jpeg_chroma_subsampling(path)
+    assert sub == (2, 2)  # OpenCV's default, as most cameras write
+    plain = ImageStore([str(path)], [(64, 48)], 3, "uint8", windowed=False)
+    store = ImageStore([str(path)], [(64, 48)], 3, "uint8", windowed=False, chroma=[sub])
+    assert np.array_equal(store.get(0), restore_chroma(plain.get(0), sub))
+    assert not np.array_equal(store.get(0), plain.get(0))
+    assert np.array_equal(store.get(0, 1), plain.get(0, 1))  # a reduced level is left as decoded
+    copy = pickle.loads(pickle.dumps(store))
+    assert copy.chroma == [sub] and np.array_equal(copy.get(0), store.get(0))
+    with pytest.raises(InputError, match="chroma"):
+        ImageStore([str(path)], [(64, 48)], 3, "uint8", chroma=[sub, None])

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 import time
 
@@ -292,7 +293,7 @@ def test_invalid_config():
         make_scene(SceneConfig(extent=(0.0, 0.0, 30.0, 30.0), n_buildings=20))
 
 
-def test_harder_appearance_options():
+def test_harder_appearance_options(tmp_path):
     """Shadows (images and truth alike), JPEG artefacts, low-contrast roofs and facade windows."""
     plain = make_scene(_small(noise_sigma=0.0, vignetting=0.0, gain_sigma=0.0, offset_sigma=0.0))
     hard = make_scene(
@@ -308,7 +309,12 @@ def test_harder_appearance_options():
             facade_windows=True,
         )
     )
-    assert plain.orientation.to_dict() == hard.orientation.to_dict()
+    # the same cameras; a JPEG block's images are JPEG files (img_NNN.jpg), the plain one's PNGs
+    assert [im.name for im in hard.orientation.images] == [
+        im.name[:-4] + ".jpg" for im in plain.orientation.images
+    ]
+    as_png = json.dumps(hard.orientation.to_dict()).replace(".jpg", ".png")
+    assert as_png == json.dumps(plain.orientation.to_dict())
     # truth orthophoto: shadowed cells are exactly half as bright, lit cells unchanged
     a, _ = plain.orthophoto(0.5, as_uint8=False)
     b, _ = hard.orthophoto(0.5, as_uint8=False)
@@ -335,6 +341,16 @@ def test_harder_appearance_options():
     diff = np.abs(hard.images[0].astype(float) - ref)
     assert 0.2 < diff.mean() < 15.0  # quality 60 on a fine texture
     assert np.corrcoef(hard.images[0].ravel(), ref.ravel())[0, 1] > 0.9
+    # write() stores the JPEG files as they are: decoded, they are the scene's images
+    import cv2
+
+    folder = tmp_path / "hard"
+    hard.write(folder)
+    assert len(hard.jpeg_files) == len(hard.images)
+    first = folder / hard.orientation.images[0].name
+    assert first.read_bytes()[:2] == b"\xff\xd8" and first.read_bytes() == hard.jpeg_files[0]
+    assert np.array_equal(cv2.imread(str(first), cv2.IMREAD_COLOR)[:, :, ::-1], hard.images[0])
+    assert not plain.jpeg_files
     # windows: wall pixels of the hard scene hold many very dark pixels, the plain scene's none
     wall = noise_free.material == WALL
     if wall.sum() > 50:

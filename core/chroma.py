@@ -1,0 +1,176 @@
+"""Colour detail that JPEG chroma subsampling took away, restored from the luma.
+
+Cameras store most JPEGs with the colour (Cb, Cr) at half the resolution of the brightness
+(4:2:0: half across and half down; 4:2:2: half across). The decoder interpolates the colour back,
+so a colour edge, a red roof beside grey asphalt, is smeared over two or three pixels while the
+brightness edge stays sharp. A true orthophoto made at the images' ground resolution paints those
+smeared colours along every outline. On the acceptance battery's scenes (JPEG 4:2:0, quality
+70-95) the true ortho on the exact DSM put colours more than dE 25 off on 1.9-6.8 % of the
+2-GSD band around the buildings; the same scenes encoded at the same quality with full-resolution
+colour (4:4:4) read 0.05-0.42 %.
+
+:func:`jpeg_chroma_subsampling` reads the subsampling from the file's frame header, and
+:func:`restore_chroma` gives every pixel the colour of the nearby pixels that have its brightness
+and lie away from the smear: a joint bilateral filter of Cb and Cr over a window as wide as the
+subsampling, with weights that fall with the distance, with the difference in luma, and with the
+colour gradient of the neighbour (the smeared pixels are where the colour changes; the pixels
+beyond the smear keep flat colour). The luma is not changed. Only 8-bit RGB images are restored;
+the colour conversions are JPEG's own (BT.601, full range).
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from .errors import InputError
+from .jit import njit, pjit, prange
+
+#: Spread of the luma difference (0-255; 3 % of the range) over which a neighbour's weight falls by
+#: e^-1/2: pixels of the same material differ by the images' noise and texture, an outline by tens
+#: of levels.
+SIGMA_LUMA = 0.03 * 255.0
+#: Spread of the neighbour distance (pixels).
+SIGMA_SPACE = 1.5
+#: Colour gradient (Sobel magnitude of Cb plus that of Cr, 0-255 scale; 5 % of the range) over which
+#: a neighbour's weight falls by e^-1: inside a smear it is tens of levels, on flat colour a few.
+GRADIENT_SCALE = 0.05 * 255.0
+
+_SOF = frozenset((0xC0, 0xC1, 0xC2, 0xC3, 0xC5, 0xC6, 0xC7, 0xC9, 0xCA, 0xCB, 0xCD, 0xCE, 0xCF))
+
+
+def jpeg_chroma_subsampling(path) -> tuple[int, int] | None:
+    """The colour subsampling ``(across, down)`` of a 3-component JPEG: (2, 2) for 4:2:0, (2, 1) for
+    4:2:2, (1, 1) for 4:4:4. None for any other file (not a JPEG, grey, CMYK, unreadable header)."""
+    try:
+        with open(os.fspath(path), "rb") as fh:
+            if fh.read(2) != b"\xff\xd8":
+                return None
+            while True:
+                b = fh.read(1)
+                if not b:
+                    return None
+                if b != b"\xff":
+                    continue
+                marker = fh.read(1)
+                while marker == b"\xff":  # fill bytes
+                    marker = fh.read(1)
+                if not marker:
+                    return None
+                m = marker[0]
+                if m in (0xD8, 0x01) or 0xD0 <= m <= 0xD7:  # no length
+                    continue
+                if m in (0xD9, 0xDA):  # end of image or start of scan before any frame header
+                    return None
+                head = fh.read(2)
+                if len(head) < 2:
+                    return None
+                length = int.from_bytes(head, "big")
+                if m in _SOF:
+                    seg = fh.read(length - 2)
+                    if len(seg) < 6 or seg[5] != 3 or len(seg) < 6 + 9:
+                        return None
+                    hv = [(seg[6 + 3 * k + 1] >> 4, seg[6 + 3 * k + 1] & 15) for k in range(3)]
+                    (hy, vy), (hb, vb), (hr, vr) = hv
+                    if min(hb, vb, hr, vr) < 1 or hy % hb or vy % vb or (hb, vb) != (hr, vr):
+                        return None
+                    return hy // hb, vy // vb
+                fh.seek(length - 2, os.SEEK_CUR)
+    except OSError:
+        return None
+
+
+@njit
+def _ycc(r, g, b):
+    y = 0.299 * r + 0.587 * g + 0.114 * b
+    cb = 128.0 - 0.168736 * r - 0.331264 * g + 0.5 * b
+    cr = 128.0 + 0.5 * r - 0.418688 * g - 0.081312 * b
+    return y, cb, cr
+
+
+@pjit
+def _planes(img, y, cb, cr):
+    rows, cols = y.shape
+    for i in prange(rows):
+        for j in range(cols):
+            y[i, j], cb[i, j], cr[i, j] = _ycc(float(img[i, j, 0]), float(img[i, j, 1]), float(img[i, j, 2]))
+
+
+@pjit
+def _gradient(cb, cr, out):
+    """Sobel gradient magnitude of Cb plus that of Cr (edges replicated)."""
+    rows, cols = cb.shape
+    for i in prange(rows):
+        i0 = max(i - 1, 0)
+        i1 = min(i + 1, rows - 1)
+        for j in range(cols):
+            j0 = max(j - 1, 0)
+            j1 = min(j + 1, cols - 1)
+            s = 0.0
+            for p in (cb, cr):
+                gx = (p[i0, j1] + 2.0 * p[i, j1] + p[i1, j1]) - (p[i0, j0] + 2.0 * p[i, j0] + p[i1, j0])
+                gy = (p[i1, j0] + 2.0 * p[i1, j] + p[i1, j1]) - (p[i0, j0] + 2.0 * p[i0, j] + p[i0, j1])
+                s += np.sqrt(gx * gx + gy * gy)
+            out[i, j] = s
+
+
+@pjit
+def _filter(img, y, cb, cr, grad, rx, ry, s_luma, s_space, g_scale, out):
+    rows, cols = y.shape
+    a = -0.5 / (s_luma * s_luma)
+    b = -0.5 / (s_space * s_space)
+    for i in prange(rows):
+        for j in range(cols):
+            y0 = y[i, j]
+            num_b = 0.0
+            num_r = 0.0
+            den = 0.0
+            for di in range(-ry, ry + 1):
+                ii = min(max(i + di, 0), rows - 1)
+                for dj in range(-rx, rx + 1):
+                    jj = min(max(j + dj, 0), cols - 1)
+                    d = y[ii, jj] - y0
+                    w = np.exp(a * d * d + b * (di * di + dj * dj) - grad[ii, jj] / g_scale)
+                    num_b += w * cb[ii, jj]
+                    num_r += w * cr[ii, jj]
+                    den += w
+            if den > 1e-30:
+                vb = num_b / den - 128.0
+                vr = num_r / den - 128.0
+            else:
+                vb = cb[i, j] - 128.0
+                vr = cr[i, j] - 128.0
+            rgb = (y0 + 1.402 * vr, y0 - 0.344136 * vb - 0.714136 * vr, y0 + 1.772 * vb)
+            for k in range(3):
+                out[i, j, k] = np.uint8(min(max(rgb[k] + 0.5, 0.0), 255.0))
+
+
+def restore_chroma(img: np.ndarray, subsampling: tuple[int, int]) -> np.ndarray:
+    """``img`` (H, W, 3) uint8 RGB decoded from a JPEG whose colour was subsampled by
+    ``subsampling = (across, down)`` (:func:`jpeg_chroma_subsampling`), with its colour restored
+    (module docstring); unchanged (the same array) for (1, 1)."""
+    a = np.asarray(img)
+    if a.dtype != np.uint8 or a.ndim != 3 or a.shape[2] != 3:
+        raise InputError(f"restore_chroma: expected an (H, W, 3) uint8 RGB image, got {a.dtype} {a.shape}")
+    try:
+        rx, ry = (int(v) for v in subsampling)
+    except (TypeError, ValueError):
+        raise InputError(
+            f"restore_chroma: subsampling must be two whole numbers, got {subsampling!r}"
+        ) from None
+    if not (1 <= rx <= 4 and 1 <= ry <= 4):
+        raise InputError(f"restore_chroma: subsampling factors must be 1 to 4, got {subsampling!r}")
+    if (rx, ry) == (1, 1) or a.size == 0:
+        return a
+    a = np.ascontiguousarray(a)
+    y = np.empty(a.shape[:2], np.float32)
+    cb = np.empty_like(y)
+    cr = np.empty_like(y)
+    _planes(a, y, cb, cr)
+    grad = np.empty_like(y)
+    _gradient(cb, cr, grad)
+    out = np.empty_like(a)
+    # the smear of a subsampling factor f reaches about f pixels on each side of an edge
+    _filter(a, y, cb, cr, grad, rx, ry, SIGMA_LUMA, SIGMA_SPACE, GRADIENT_SCALE, out)
+    return out
