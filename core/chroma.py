@@ -15,7 +15,11 @@ and lie away from the smear: a joint bilateral filter of Cb and Cr over a window
 subsampling, with weights that fall with the distance, with the difference in luma, and with the
 colour gradient of the neighbour (the smeared pixels are where the colour changes; the pixels
 beyond the smear keep flat colour). The luma is not changed. Only 8-bit RGB images are restored;
-the colour conversions are JPEG's own (BT.601, full range).
+the colour conversions are JPEG's own (BT.601, full range). The distance and flatness weights are
+computed once and the luma weight comes from a table (1/16 level steps): a 12 MP image takes
+about 1.3 s on two threads, against 0.07 s to decode it, so only full-resolution levels are
+restored (a reduced level's pixel averages 2 x 2 pixels or more, and its colour is about as sharp
+as its luma).
 """
 
 from __future__ import annotations
@@ -115,11 +119,25 @@ def _gradient(cb, cr, out):
             out[i, j] = s
 
 
+#: Steps per luma level of the table of luma weights (:func:`_filter`).
+_LUT_STEPS = 16
+
+
 @pjit
-def _filter(img, y, cb, cr, grad, rx, ry, s_luma, s_space, g_scale, out):
+def _flatness(grad, g_scale, out):
+    """``exp(-grad / g_scale)``: the weight of a neighbour for the flatness of its colour."""
+    rows, cols = grad.shape
+    for i in prange(rows):
+        for j in range(cols):
+            out[i, j] = np.exp(-grad[i, j] / g_scale)
+
+
+@pjit
+def _filter(y, cb, cr, flat, rx, ry, lut, space, out):
+    """Every pixel's colour: the mean Cb, Cr of its ``(2 rx + 1) x (2 ry + 1)`` window weighted by
+    ``space`` (distance), ``lut`` (luma difference, :data:`_LUT_STEPS` per level) and ``flat``."""
     rows, cols = y.shape
-    a = -0.5 / (s_luma * s_luma)
-    b = -0.5 / (s_space * s_space)
+    top = lut.shape[0] - 1
     for i in prange(rows):
         for j in range(cols):
             y0 = y[i, j]
@@ -130,8 +148,8 @@ def _filter(img, y, cb, cr, grad, rx, ry, s_luma, s_space, g_scale, out):
                 ii = min(max(i + di, 0), rows - 1)
                 for dj in range(-rx, rx + 1):
                     jj = min(max(j + dj, 0), cols - 1)
-                    d = y[ii, jj] - y0
-                    w = np.exp(a * d * d + b * (di * di + dj * dj) - grad[ii, jj] / g_scale)
+                    k = int(abs(y[ii, jj] - y0) * _LUT_STEPS + 0.5)
+                    w = space[di + ry, dj + rx] * lut[min(k, top)] * flat[ii, jj]
                     num_b += w * cb[ii, jj]
                     num_r += w * cr[ii, jj]
                     den += w
@@ -170,7 +188,13 @@ def restore_chroma(img: np.ndarray, subsampling: tuple[int, int]) -> np.ndarray:
     _planes(a, y, cb, cr)
     grad = np.empty_like(y)
     _gradient(cb, cr, grad)
-    out = np.empty_like(a)
+    flat = np.empty_like(y)
+    _flatness(grad, GRADIENT_SCALE, flat)
+    d = np.arange(256 * _LUT_STEPS + 1) / _LUT_STEPS
+    lut = np.exp(-0.5 * (d / SIGMA_LUMA) ** 2).astype(np.float32)
     # the smear of a subsampling factor f reaches about f pixels on each side of an edge
-    _filter(a, y, cb, cr, grad, rx, ry, SIGMA_LUMA, SIGMA_SPACE, GRADIENT_SCALE, out)
+    dy, dx = np.mgrid[-ry : ry + 1, -rx : rx + 1]
+    space = np.exp(-0.5 * (dx * dx + dy * dy) / SIGMA_SPACE**2).astype(np.float32)
+    out = np.empty_like(a)
+    _filter(y, cb, cr, flat, rx, ry, lut, space, out)
     return out
