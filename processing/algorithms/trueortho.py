@@ -49,6 +49,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     CRS = "CRS"
     COLOR_CORRECTION = "COLOR_CORRECTION"
     VIGNETTING = "VIGNETTING"
+    RESTORE_CHROMA = "RESTORE_CHROMA"
     MAX_VIEW_ANGLE = "MAX_VIEW_ANGLE"
     BLEND_WIDTH = "BLEND_WIDTH"
     TILE_SIZE = "TILE_SIZE"
@@ -65,6 +66,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
         RESOLUTION: FromConfig("ortho.pipeline.TrueOrthoConfig", "resolution", none=0.0),
         COLOR_CORRECTION: FromConfig("ortho.pipeline.TrueOrthoConfig", "color_correction"),
         VIGNETTING: FromConfig("ortho.pipeline.TrueOrthoConfig", "vignetting"),
+        RESTORE_CHROMA: FromConfig("ortho.pipeline.TrueOrthoConfig", "restore_chroma"),
         MAX_VIEW_ANGLE: FromConfig("ortho.pipeline.TrueOrthoConfig", "max_view_angle"),
         BLEND_WIDTH: FromConfig("ortho.pipeline.TrueOrthoConfig", "blend_width"),
         TILE_SIZE: FromConfig("ortho.pipeline.TrueOrthoConfig", "tile_size"),
@@ -113,6 +115,14 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 tr("Remove vignetting (with the colour correction)"),
                 self.default(self.VIGNETTING),
             )
+        )
+        self.add(
+            QgsProcessingParameterBoolean(
+                self.RESTORE_CHROMA,
+                tr("Restore the colour edges of JPEGs with half-resolution colour"),
+                self.default(self.RESTORE_CHROMA),
+            ),
+            advanced=True,
         )
         self.add(
             QgsProcessingParameterNumber(
@@ -216,6 +226,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             crs=out_crs,
             color_correction=self.parameterAsBool(parameters, self.COLOR_CORRECTION, context),
             vignetting=self.parameterAsBool(parameters, self.VIGNETTING, context),
+            restore_chroma=self.parameterAsBool(parameters, self.RESTORE_CHROMA, context),
             max_view_angle=self.parameterAsDouble(parameters, self.MAX_VIEW_ANGLE, context),
             blend_width=self.parameterAsInt(parameters, self.BLEND_WIDTH, context),
             tile_size=self.parameterAsInt(parameters, self.TILE_SIZE, context),

@@ -299,6 +299,10 @@ HELP: dict[str, dict] = {
             "VIGNETTING": "With the colour correction: estimate a radial darkening towards the image corners "
             "per camera from the overlaps and remove it first. Images without vignetting get a factor of "
             "about 1; switch it off for images already corrected in processing.",
+            "RESTORE_CHROMA": "Most cameras store JPEG colour at half the resolution of the brightness "
+            "(4:2:0 or 4:2:2, read from each file's header), so colours smear across building outlines. "
+            "When on, the colour edges of such images are restored from the brightness before they are "
+            "sampled at full resolution. Other images are not changed.",
             "MAX_VIEW_ANGLE": "Largest off-nadir angle of the viewing ray (degrees) for an image to texture "
             "a cell; also bounds how far outside a tile occluders are searched.",
             "BLEND_WIDTH": "Width of the feathering across seamlines, in cells (0 = hard seams).",
