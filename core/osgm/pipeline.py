@@ -90,7 +90,11 @@ class OsgmConfig:
         SGM penalties in cost units (``COST_MAX`` = 1023 = unrelated windows);
         default :data:`~truortho.core.sgm.DEFAULT_P1`, ``DEFAULT_P2``.
     paths : {8, 16}
-    adaptive_p2 : bool
+        Aggregation directions of SGM in XY. 16 by default: with 8 (the axes and diagonals) the
+        hillshade of natural terrain shows a fine cross-hatch along them (grid streak index of
+        the bundled sample 1.71 against 1.03, copr at 0.05 m 1.65 against 1.53), for the same
+        accuracy on the acceptance battery (NMAD median 0.21 -> 0.19 GSD, edge cells within
+        3 GSD 0.863 -> 0.869) and about 6 % more OSGM time.
         Lower P2 across edges of the coarser level's orthoimage.
     max_images : int
         Images matched per tile (best coverage, then most nadir).
@@ -158,7 +162,7 @@ class OsgmConfig:
     z_margin: float | None = None
     p1: int | None = None
     p2: int | None = None
-    paths: int = 8
+    paths: int = 16
     adaptive_p2: bool = True
     max_images: int = 12
     max_view_angle: float = 50.0

@@ -236,8 +236,9 @@ HELP: dict[str, dict] = {
             "Z_SURFACE": "Optional coarse DSM or DTM raster: the search at each cell is bounded by the "
             "lowest and highest height of its neighbourhood plus a margin, which speeds up matching and "
             "avoids wrong heights on rough terrain.",
-            "PATHS": "Number of aggregation directions of semi-global matching: 8 (faster) or 16 (smoother "
-            "slanted surfaces).",
+            "PATHS": "Number of aggregation directions of semi-global matching: 16 (the default) or 8 "
+            "(about 6 % faster; the hillshade of natural terrain then shows a fine cross-hatch along the "
+            "grid's axes and diagonals).",
             "OBLIQUE": "none: one nadir reference system (the DSM). auto: groups of oblique images also get "
             "reference systems along their viewing directions, whose points go to the point cloud with "
             "their 'system' id.",
