@@ -194,3 +194,23 @@ def test_model_bad_input(tmp_path, run_qgis_process):
     assert proc.returncode != 0
     assert "IMAGES" in proc.stdout + proc.stderr
     assert not any(p.exists() for p in out.values())
+
+
+def test_shipped_model_is_what_make_model_writes(tmp_path):
+    """processing/models/truortho_chain.model3 is regenerated from the algorithms (scripts/make_model.py):
+    a changed default or a new mandatory parameter of a child must reach the shipped model, or the
+    model and truortho:pipeline make different products (PATHS 8 against 16 did)."""
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[2]
+    out = tmp_path / "chain.model3"
+    proc = subprocess.run(
+        [sys.executable, "-P", str(root / "scripts" / "make_model.py"), "--output", str(out)],
+        capture_output=True, text=True, timeout=300,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    shipped = root / "processing" / "models" / "truortho_chain.model3"
+    assert out.read_bytes() == shipped.read_bytes(), (
+        "the shipped model is stale: run `source scripts/env.sh && python -P scripts/make_model.py`"
+    )
