@@ -95,6 +95,7 @@ class OsgmConfig:
         the bundled sample 1.71 against 1.03, copr at 0.05 m 1.65 against 1.53), for the same
         accuracy on the acceptance battery (NMAD median 0.21 -> 0.19 GSD, edge cells within
         3 GSD 0.863 -> 0.869) and about 6 % more OSGM time.
+    adaptive_p2 : bool
         Lower P2 across edges of the coarser level's orthoimage.
     max_images : int
         Images matched per tile (best coverage, then most nadir).

@@ -100,3 +100,5 @@ def test_full_resolution_colour_is_left_alone_and_bad_input_is_named():
         restore_chroma(rgb, (0, 2))
     with pytest.raises(InputError, match="subsampling"):
         restore_chroma(rgb, "2x2")
+    with pytest.raises(InputError, match="file path"):
+        jpeg_chroma_subsampling(None)
