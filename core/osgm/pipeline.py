@@ -327,6 +327,15 @@ class SystemResult:
 SEAM_BLEND = 16
 #: Largest spread of the tiles' heights at a seam cell, in Z steps of the level, that is blended.
 SEAM_TOLERANCE = 2.0
+#: Overlap (cells) of the finest level's tiles. The coarser levels' tiles overlap by
+#: ``max(16, tile_size / 8)`` cells, the run-up SGM's paths need where a cell may search the whole
+#: height range. On the finest level every cell searches a narrow band around level 1's result, so
+#: the paths need less: 16 instead of 32 cells (tile size 256) made OSGM about 12 % faster on the
+#: acceptance battery (11 scenes, 122 -> 108 s) with the mean figures unchanged or better (NMAD
+#: 0.247 -> 0.243 GSD, edge3 0.855 -> 0.856; per scene edge3 -0.9 to +1.8 points). The fine
+#: level's tiles are 4 times as many cells as the next level's, so their overlap was 30 % of
+#: the work of a 256-cell tile.
+FINE_OVERLAP = 16
 
 
 class _LevelTasks(Sequence):
@@ -429,7 +438,7 @@ def _match_system(
             raise CancelledError("OSGM cancelled")
         g = plan.grid(grid, lv)
         ts = int(cfg.tile_size)
-        ov = max(16, ts // 8)
+        ov = max(16, ts // 8) if lv > 0 else min(max(16, ts // 8), FINE_OVERLAP)
         side = ts + 2 * ov  # outer tile side, for the memory a task asks of the scheduler
         tiles = g.tiles(ts, ov)
         tasks = _LevelTasks(
