@@ -8,9 +8,8 @@ cells across), so its full-range search is cheap.
 
 On every finer level a cell searches only the band between the lowest and
 the highest coarse result of its 5 x 5 coarse neighbourhood, widened by
-:data:`MARGIN_STEPS` coarse steps (:data:`FINE_MARGIN_STEPS` on the finest
-level): a cell at a building outline keeps both the ground and the roof in its
-band. Where the coarse level has no result
+:data:`MARGIN_STEPS` coarse steps: a cell at a building outline keeps both the
+ground and the roof in its band. Where the coarse level has no result
 (rejected as ambiguous), the band comes from a 7 x 7 neighbourhood, else from
 the tile's range, else the whole range. Bands wider than :data:`MAX_BAND`
 levels are cut around the coarse value of the cell.
@@ -54,13 +53,12 @@ MIN_COARSE_CELLS = 16
 #: value, for the gaps). Two were measured: about a fifth less time and the same battery figures
 #: (six scenes: flat3 -0.1/+0.4 points, edge3 -1.6/+1.1), but 3 % less facade coverage from the
 #: oblique systems (tests/core/test_osgm.py, 0.247 -> 0.239), whose steep surfaces the coarse
-#: levels place less well.
+#: levels place less well. Two on the finest level only were also measured: 11 % less OSGM time on
+#: the battery with every figure within 0.3 points, but on boruszyn (28 real photos, 0.25 m) 18 %
+#: more cells in holes (45,500 -> 53,900; holes of 1 m^2 or more 144 -> 247): a minimum on a
+#: band's border is rejected, and level 1 misplaced the trees and steep ground there by more than
+#: two of its steps.
 MARGIN_STEPS = 3
-#: The margin of the finest level (level 0), in level-1 steps. Level 1 places the surface well
-#: enough that two steps suffice there: on the acceptance battery OSGM took about 11 % less time
-#: (11 scenes, 122 -> 109 s) and every figure moved by 0.3 points or less. The coarser levels keep
-#: :data:`MARGIN_STEPS` for the oblique systems above.
-FINE_MARGIN_STEPS = 2
 #: Widest band of levels a cell searches on a refined level.
 MAX_BAND = 192
 
@@ -235,7 +233,7 @@ def _refine(plan: LevelPlan, lv: int, coarse: np.ndarray, window):
     if np.isfinite(patch).any():
         lo = np.where(np.isfinite(lo), lo, np.nanmin(patch))
         hi = np.where(np.isfinite(hi), hi, np.nanmax(patch))
-    margin = (FINE_MARGIN_STEPS if lv == 0 else MARGIN_STEPS) * plan.dz(lv + 1)
+    margin = MARGIN_STEPS * plan.dz(lv + 1)
     rr = np.clip(np.arange(r0, r0 + nr) // 2 - cr0, 0, patch.shape[0] - 1)
     cc = np.clip(np.arange(c0, c0 + nc) // 2 - cc0, 0, patch.shape[1] - 1)
     ix = np.ix_(rr, cc)

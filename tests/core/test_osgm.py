@@ -22,7 +22,6 @@ from truortho.core.grid import RasterGrid  # noqa: E402
 from truortho.core.osgm import OsgmConfig, OsgmOutputs, plan_levels, reference_systems, run_osgm  # noqa: E402
 from truortho.core.osgm.levels import (  # noqa: E402
     COARSE_LEVELS,
-    FINE_MARGIN_STEPS,
     MARGIN_STEPS,
     MAX_BAND,
     refine_bands,
@@ -104,16 +103,13 @@ def test_level_plan_and_refined_windows():
     assert (hi - lo + 1).max() <= MAX_BAND
 
 
-def test_the_finest_level_searches_a_narrower_margin():
-    grid = RasterGrid(0.0, 100.0, 0.25, 400, 400)
-    plan = plan_levels(-5.0, 55.0, 0.25, grid)
-    assert FINE_MARGIN_STEPS < MARGIN_STEPS
-    for lv, steps in ((1, MARGIN_STEPS), (0, FINE_MARGIN_STEPS)):
-        flat = np.full(plan.grid(grid, lv + 1).shape, 10.0, np.float32)  # flat ground at 10 m
-        lo, hi = refine_windows(plan, lv, flat, (0, 0, 40, 40))
-        # the band: the coarse height widened by `steps` coarse steps (2 levels each) on both sides
-        assert (plan.z_base + lo * plan.dz(lv) == 10.0 - steps * plan.dz(lv + 1)).all(), lv
-        assert (plan.z_base + hi * plan.dz(lv) == 10.0 + steps * plan.dz(lv + 1)).all(), lv
+def test_the_finest_level_tiles_overlap_less():
+    from truortho.core.osgm.pipeline import FINE_OVERLAP, level_overlap
+
+    for ts in (64, 256, 1024):
+        assert level_overlap(ts, 0) == min(FINE_OVERLAP, max(16, ts // 8))
+        assert all(level_overlap(ts, lv) == max(16, ts // 8) for lv in (1, 2, 5))
+    assert level_overlap(256, 0) < level_overlap(256, 1)
 
 
 def test_refined_bands_skip_the_heights_between_two_surfaces():
@@ -126,7 +122,7 @@ def test_refined_bands_skip_the_heights_between_two_surfaces():
     coarse[20, 20] = np.nan
     lo, hi, glo, ghi = refine_bands(plan, 0, coarse, (0, 0, 400, 400))
     assert np.array_equal((lo, hi), refine_windows(plan, 0, coarse, (0, 0, 400, 400)))
-    margin = FINE_MARGIN_STEPS * plan.dz(1)  # level 0 refines from level 1 with the fine margin
+    margin = MARGIN_STEPS * plan.dz(1)
     # at the wall: both surfaces and their margins searched, the heights between them skipped
     r, c = 10, 199
     assert z(lo[r, c]) <= -margin and z(hi[r, c]) >= 10.0 + margin
