@@ -535,9 +535,10 @@ def run_header(script: str, argv, detail: str = "", started: str | None = None) 
     ``started``: the commit when the run started (:func:`_docs.commit`, ``+dirty`` for a changed
     tree); the figures are that code's. If HEAD moved during the run, the head says so.
     """
-    cmd = f"python -P bench/{script} " + " ".join(argv if argv is not None else sys.argv[1:])
     sys.path.insert(0, HERE)
-    from _docs import load_average, measured_commit
+    from _docs import load_average, measured_commit, shown_argv
+
+    cmd = f"python -P bench/{script} " + " ".join(shown_argv(argv if argv is not None else sys.argv[1:]))
 
     commit = measured_commit(started)
 

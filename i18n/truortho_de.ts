@@ -824,77 +824,82 @@
             <translation>Fotos zum True Orthophoto (gesamte Prozesskette)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="94" />
+            <location filename="../processing/algorithms/pipeline.py" line="104" />
             <source>DSM (filtered)</source>
             <translation>DOM (gefiltert)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="97" />
+            <location filename="../processing/algorithms/pipeline.py" line="107" />
             <source>True orthophoto</source>
             <translation>True Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="98" />
+            <location filename="../processing/algorithms/pipeline.py" line="108" />
             <source>Occlusion mask</source>
             <translation>Verdeckungsmaske</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="99" />
+            <location filename="../processing/algorithms/pipeline.py" line="109" />
             <source>Seamlines</source>
             <translation>Nahtlinien</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="76" />
+            <location filename="../processing/algorithms/pipeline.py" line="78" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Auflösung des DOM und des True Orthophotos (m, 0 = Bodenpixelgröße)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="85" />
+            <location filename="../processing/algorithms/pipeline.py" line="87" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Eine vorhandene orientation.json im Ausgabeordner wiederverwenden</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="114" />
+            <location filename="../processing/algorithms/pipeline.py" line="94" />
+            <source>Restore the colour edges of JPEGs with half-resolution colour</source>
+            <translation>Farbkanten von JPEGs mit halbierter Farbauflösung wiederherstellen</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/pipeline.py" line="124" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES: geben Sie den Ordner der Fotos an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="129" />
+            <location filename="../processing/algorithms/pipeline.py" line="140" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER: geben Sie einen Ordner für die Produkte an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="139" />
+            <location filename="../processing/algorithms/pipeline.py" line="150" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION: positive Anzahl Meter oder 0 erwartet</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="175" />
+            <location filename="../processing/algorithms/pipeline.py" line="187" />
             <source>DSM (TruOrtho)</source>
             <translation>DOM (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="176" />
+            <location filename="../processing/algorithms/pipeline.py" line="188" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>True Orthophoto (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="177" />
+            <location filename="../processing/algorithms/pipeline.py" line="189" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Verdeckung (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="178" />
+            <location filename="../processing/algorithms/pipeline.py" line="190" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Nahtlinien (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="159" />
+            <location filename="../processing/algorithms/pipeline.py" line="171" />
             <source>Tiles ran on: {}</source>
             <translation>Kacheln berechnet auf: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="158" />
+            <location filename="../processing/algorithms/pipeline.py" line="170" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{}: {:.1f} s, Spitze {:.0f} MB; {}</translation>
         </message>
@@ -997,11 +1002,6 @@
             <location filename="../processing/algorithms/trueortho.py" line="115" />
             <source>Remove vignetting (with the colour correction)</source>
             <translation>Vignettierung entfernen (mit der Farbkorrektur)</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/trueortho.py" line="122" />
-            <source>Restore the colour edges of JPEGs with half-resolution colour</source>
-            <translation>Farbkanten von JPEGs mit halbierter Farbauflösung wiederherstellen</translation>
         </message>
         <message>
             <location filename="../processing/algorithms/trueortho.py" line="130" />
@@ -1365,501 +1365,501 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="176" />
-            <source>Where the tiles of dense matching, DSM filtering and the true orthophoto are computed, by one executor for the three stages (a local cluster starts once); the products are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the photos and OUTPUT_FOLDER at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The orientation, the mesh and the report are computed in QGIS's process. The address is checked before the orientation starts; the scheduler is first contacted by dense matching.</source>
-            <translation>Wo die Kacheln der dichten Bildzuordnung, der DOM-Filterung und des True Orthophotos berechnet werden, durch einen Executor für alle drei Schritte (ein lokaler Cluster startet nur einmal); die Produkte sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Fotos und OUTPUT_FOLDER unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Orientierung, Dreiecksnetz und Bericht werden im Prozess von QGIS berechnet. Die Adresse wird vor dem Start der Orientierung geprüft; der Scheduler wird erstmals von der dichten Bildzuordnung kontaktiert.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="187" />
-            <source>Folder of the products (created when missing; existing products are replaced). It holds only products: orientation.json (adjusted orientation), report.html and report.json (the quality report and its data), dsm_raw.tif (DSM as matched, before filtering), confidence.tif (matching confidence 0 to 1), orthoimage.tif (colour of each DSM cell from the matching, not a true orthophoto), dsm.tif (filtered DSM), pointcloud.laz, mesh.ply, trueortho.tif, source_index.tif (which photo each true-orthophoto cell comes from), occlusion.tif and seamlines.gpkg. Caches (compiled kernels, image features) are kept in the per-user cache folder (environment variable TRUORTHO_CACHE_DIR; truortho:environment shows and clears it).</source>
-            <translation>Ordner der Produkte (wird angelegt, falls er fehlt; vorhandene Produkte werden ersetzt). Er enthält nur Produkte: orientation.json (ausgeglichene Orientierung), report.html und report.json (der Qualitätsbericht und seine Daten), dsm_raw.tif (DOM wie zugeordnet, vor der Filterung), confidence.tif (Zuordnungskonfidenz 0 bis 1), orthoimage.tif (Farbe jeder DOM-Zelle aus der Zuordnung, kein True-Orthophoto), dsm.tif (gefiltertes DOM), pointcloud.laz, mesh.ply, trueortho.tif, source_index.tif (aus welchem Foto jede True-Orthophoto-Zelle stammt), occlusion.tif und seamlines.gpkg. Caches (kompilierte Kernel, Bildmerkmale) liegen im benutzereigenen Cache-Ordner (Umgebungsvariable TRUORTHO_CACHE_DIR; truortho:environment zeigt und leert ihn).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="196" />
-            <source>orientation.json: the adjusted orientation.</source>
-            <translation>orientation.json: die ausgeglichene Orientierung.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="197" />
-            <source>report.html (and report.json): the quality report of the run.</source>
-            <translation>report.html (und report.json): der Qualitätsbericht des Laufs.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="198" />
-            <source>dsm.tif: the filtered DSM (float32, nodata -9999).</source>
-            <translation>dsm.tif: das gefilterte DOM (float32, NoData -9999).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="199" />
-            <source>pointcloud.laz: the matched points with colour and confidence.</source>
-            <translation>pointcloud.laz: die zugeordneten Punkte mit Farbe und Konfidenz.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="200" />
-            <source>mesh.ply: 2.5D mesh of the filtered DSM with vertical walls and vertex colours.</source>
-            <translation>mesh.ply: 2,5D-Dreiecksnetz des gefilterten DOM mit senkrechten Wänden und Eckpunktfarben.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="201" />
-            <source>trueortho.tif: the true orthophoto (bands of the photos + alpha, COG).</source>
-            <translation>trueortho.tif: das True Orthophoto (Kanäle der Fotos + Alpha, COG).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="202" />
-            <source>occlusion.tif: 1 where no photo sees the surface.</source>
-            <translation>occlusion.tif: 1, wo kein Foto die Oberfläche sieht.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="203" />
-            <source>seamlines.gpkg: one polygon per source photo.</source>
-            <translation>seamlines.gpkg: ein Polygon je Quellfoto.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="208" />
-            <source>Dense image matching in object space (OSGM): computes a DSM directly on a ground grid from the oriented images, without rectification or pairwise depth maps. For every tile of the grid the images that see it (at most MAX_IMAGES) are resampled onto the horizontal plane of every search height (voxels of RESOLUTION x RESOLUTION x Z_STEP); a matching cost from all of them per cell and height is aggregated by semi-global matching along 8 or 16 paths (penalty P1 for a change of one height step, P2 for larger jumps, lowered across image edges), and each cell takes the height of least aggregated cost, refined between steps, with a confidence in [0, 1]. Matching runs coarse to fine over an image pyramid, by tiles, with progress and cancel. Cells without a reliable match are nodata (filter and fill them with truortho:dsmfilter). Optionally writes the confidence, an orthoimage coloured from the matched images, and a point cloud; with OBLIQUE = auto, groups of oblique images are matched in extra reference systems along their viewing directions, whose points (facades) go to the point cloud.</source>
-            <translation>Dichte Bildzuordnung im Objektraum (OSGM): berechnet ein DOM direkt auf einem Bodenraster aus den orientierten Bildern, ohne Epipolarentzerrung oder paarweise Tiefenkarten. Für jede Kachel des Rasters werden die Bilder, die sie sehen (höchstens MAX_IMAGES), auf die horizontale Ebene jeder Suchhöhe umgebildet (Voxel von RESOLUTION x RESOLUTION x Z_STEP); ein Zuordnungskostenwert aus allen diesen Bildern je Zelle und Höhe wird durch Semi-Global Matching entlang 8 oder 16 Pfaden aggregiert (Strafterm P1 für eine Änderung um einen Höhenschritt, P2 für größere Sprünge, an Bildkanten verringert), und jede Zelle erhält die Höhe mit den geringsten aggregierten Kosten, zwischen den Schritten verfeinert, mit einer Konfidenz in [0, 1]. Die Zuordnung läuft grob-zu-fein über eine Bildpyramide, kachelweise, mit Fortschrittsanzeige und Abbruchmöglichkeit. Zellen ohne zuverlässige Zuordnung sind NoData (mit truortho:dsmfilter filtern und füllen). Optional werden die Konfidenz, ein aus den zugeordneten Bildern eingefärbtes Orthobild und eine Punktwolke geschrieben; mit OBLIQUE = auto werden Gruppen von Schrägbildern in zusätzlichen Referenzsystemen entlang ihrer Blickrichtungen zugeordnet, deren Punkte (Fassaden) in die Punktwolke gehen.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="222" />
-            <source>Orientation JSON (from Orient images or Import orientation) with a projected CRS (metres) and at least two images, which must be on disk.</source>
-            <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren) mit einem projizierten KBS (Meter) und mindestens zwei Bildern, die auf der Festplatte vorhanden sein müssen.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="224" />
-            <source>Area to match (reprojected to the orientation's CRS); default the extent of the sparse points (1-99 %), else the union of the near-nadir image footprints. It must intersect the area the images see.</source>
-            <translation>Zuzuordnender Bereich (in das KBS der Orientierung umprojiziert); Standard ist die Ausdehnung der dünnen Punktwolke (1-99 %), sonst die Vereinigung der Bildabdeckungen der nadirnahen Bilder. Er muss den von den Bildern gesehenen Bereich schneiden.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="227" />
-            <source>Cell size of the DSM, metres; empty or 0 = the median ground sample distance of the near-nadir images.</source>
-            <translation>Zellgröße des DOM, Meter; leer oder 0 = mittlere Bodenpixelgröße (Median) der nadirnahen Bilder.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="229" />
-            <source>Height step between two search planes, metres; empty or 0 = the resolution.</source>
-            <translation>Höhenschritt zwischen zwei Suchebenen, Meter; leer oder 0 = die Auflösung.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="230" />
-            <source>Lowest height searched (world Z, the orientation's vertical datum); empty = from the sparse points (0.5 % percentile minus a margin), else from the GCP heights. Must be below Z_MAX.</source>
-            <translation>Niedrigste gesuchte Höhe (Welt-Z, das Höhendatum der Orientierung); leer = aus der dünnen Punktwolke (0,5-%-Perzentil minus einem Rand), sonst aus den Passpunkthöhen. Muss unter Z_MAX liegen.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="233" />
-            <source>Highest height searched; empty = from the sparse points (99.5 % percentile plus a margin), else half the flying height above the highest GCP. Always kept below the cameras. Without sparse points or GCPs give Z_MIN and Z_MAX.</source>
-            <translation>Höchste gesuchte Höhe; leer = aus der dünnen Punktwolke (99,5-%-Perzentil plus einem Rand), sonst die halbe Flughöhe über dem höchsten Passpunkt. Bleibt immer unterhalb der Kameras. Ohne dünne Punktwolke oder Passpunkte Z_MIN und Z_MAX angeben.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="236" />
-            <source>Optional coarse DSM or DTM raster: the search at each cell is bounded by the lowest and highest height of its neighbourhood plus a margin, which speeds up matching and avoids wrong heights on rough terrain.</source>
-            <translation>Optionales grobes DOM- oder DGM-Raster: die Suche an jeder Zelle wird durch die niedrigste und höchste Höhe ihrer Nachbarschaft plus einen Rand begrenzt, was die Zuordnung beschleunigt und falsche Höhen in rauem Gelände vermeidet.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="239" />
-            <source>Number of aggregation directions of semi-global matching: 16 (the default) or 8 (about 6 % faster; the hillshade of natural terrain then shows a fine cross-hatch along the grid's axes and diagonals).</source>
-            <translation>Anzahl der Aggregationsrichtungen des Semi-Global-Matchings: 16 (Standard) oder 8 (etwa 6 % schneller; die Schummerung natürlichen Geländes zeigt dann ein feines Gittermuster entlang der Achsen und Diagonalen des Rasters).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="242" />
-            <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
-            <translation>none: ein Nadir-Referenzsystem (das DOM). auto: Gruppen von Schrägbildern erhalten zusätzlich Referenzsysteme entlang ihrer Blickrichtungen, deren Punkte mit ihrer 'system'-Kennung in die Punktwolke gehen.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="245" />
-            <source>Penalty for a change of one height step between neighbouring cells, in cost units (unrelated image windows cost 1023); empty = 256.</source>
-            <translation>Strafterm für eine Änderung um einen Höhenschritt zwischen benachbarten Zellen, in Kosteneinheiten (unabhängige Bildfenster kosten 1023); leer = 256.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="247" />
-            <source>Penalty for a larger height jump, above P1 and at most 3072; empty = 2048 (a jump then needs contrary evidence from two cells).</source>
-            <translation>Strafterm für einen größeren Höhensprung, über P1 und höchstens 3072; leer = 2048 (ein Sprung erfordert dann Gegenevidenz aus zwei Zellen).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="249" />
-            <source>Largest number of images matched per tile (best coverage first, then the most nadir; more only where fewer would leave part of the tile with under 2 views); memory and time grow with it.</source>
-            <translation>Größte Anzahl pro Kachel zugeordneter Bilder (beste Abdeckung zuerst, dann die nadirnächsten; mehr nur, wo weniger einen Teil der Kachel mit weniger als 2 Ansichten ließen); Speicherbedarf und Rechenzeit wachsen damit.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="252" />
-            <source>Tile side in cells; memory grows with its square, the number of search heights and MAX_IMAGES.</source>
-            <translation>Kachelseite in Zellen; der Speicherbedarf wächst mit ihrem Quadrat, der Anzahl der Suchhöhen und MAX_IMAGES.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="254" />
-            <source>Where the tiles are matched; the DSM and confidence are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with the same inputs and parameters after a crash reuses them.</source>
-            <translation>Wo die Kacheln zugeordnet werden; DOM und Konfidenz sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Fertige Kacheln werden bis zum Ende des Laufs neben dem DOM aufbewahrt (DSM.tif.tiles), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="263" />
-            <source>The raw DSM: GeoTIFF, float32, in the orientation's CRS, nodata -9999.</source>
-            <translation>Das rohe DOM: GeoTIFF, float32, im KBS der Orientierung, NoData -9999.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="264" />
-            <source>Optional confidence GeoTIFF (float32 in [0, 1], nodata -1) on the DSM grid, for truortho:dsmfilter.</source>
-            <translation>Optionales Konfidenz-GeoTIFF (float32 in [0, 1], NoData -1) auf dem DOM-Raster, für truortho:dsmfilter.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="266" />
-            <source>Optional RGB orthoimage GeoTIFF (uint8, 0 = no data) on the DSM grid, coloured from the matched images; not a true orthophoto (use truortho:trueortho for that).</source>
-            <translation>Optionales RGB-Orthobild als GeoTIFF (uint8, 0 = keine Daten) auf dem DOM-Raster, aus den zugeordneten Bildern eingefärbt; kein True Orthophoto (dafür truortho:trueortho verwenden).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="268" />
-            <source>Optional point cloud (.laz or .las; LAS 1.4 with colours, 'confidence' and 'system', the reference system of each point).</source>
-            <translation>Optionale Punktwolke (.laz oder .las; LAS 1.4 mit Farben, 'confidence' und 'system', dem Referenzsystem jedes Punktes).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="270" />
-            <source>JSON: grid size, resolution, height step and range (and where it came from), pyramid levels, tiles, completeness, mean confidence, reference systems, time.</source>
-            <translation>JSON: Rastergröße, Auflösung, Höhenschritt und -bereich (und woher er stammt), Pyramidenstufen, Kacheln, Vollständigkeit, mittlere Konfidenz, Referenzsysteme, Zeit.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="276" />
-            <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
-            <translation>Berechnet ein True Orthophoto aus orientierten Bildern und einer Oberfläche (einem DOM-Raster wie dem von OSGM oder einem PLY/OBJ-Dreiecksnetz): jede Zelle wird aus einem Bild eingefärbt, das sie wirklich sieht, ermittelt mit einem Tiefenpuffer der Oberfläche je Bild (DOM-Zellen als flache Dächer mit senkrechten Wänden an Höhensprüngen, oder die Dreiecke des Netzes; Frustum- und Rückseiten-Culling). Unter den Bildern, die eine Zelle sehen, wird dasjenige mit der feinsten effektiven Bodenauflösung (Entfernung und Einfallswinkel auf der Oberfläche) bevorzugt; Dächer werden jeweils aus einem einzigen Bild texturiert, und die Nahtlinien folgen Höhensprüngen und meiden Stellen, an denen die Bilder nicht übereinstimmen (Label-Glättung), mit Überblendung über die Nähte nur zwischen Bildern, die beide die Zellen sehen. Farbkorrekturen je Bild in CIE L*a*b* (Verstärkung/Versatz je Kanal für Nicht-RGB-Daten) werden per Ausgleichung nach kleinsten Quadraten aus Zellen geschätzt, die mehrere Bilder sehen. Zellen, die kein Bild sieht, erhalten Alpha 0 und erscheinen in der Verdeckungsmaske. Kanalanzahl und Datentyp der Bilder bleiben erhalten (RGB, 16-Bit-panchromatisch, thermal). Die Verarbeitung läuft kachelweise mit begrenztem Speicher; Fortschritt und Abbruch je Kachel.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="290" />
-            <source>Orientation JSON (from Orient images or Import orientation); its images must be on disk.</source>
-            <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren); seine Bilder müssen auf der Festplatte vorhanden sein.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="292" />
-            <source>DSM GeoTIFF (any CRS; resampled onto the output grid by nearest neighbour) or a PLY/OBJ mesh. Heights must use the orientation's vertical datum. It must cover the extent.</source>
-            <translation>DOM-GeoTIFF (beliebiges KBS; per nächstem Nachbarn auf das Ausgaberaster umgebildet) oder ein PLY/OBJ-Dreiecksnetz. Die Höhen müssen das Höhendatum der Orientierung verwenden. Es muss die Ausdehnung abdecken.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="294" />
-            <source>Output extent; default the surface's extent.</source>
-            <translation>Ausgabeausdehnung; Standard ist die Ausdehnung der Oberfläche.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="295" />
-            <source>Output cell size in units of the output CRS; 0 = the DSM's cell size.</source>
-            <translation>Ausgabezellgröße in Einheiten des Ausgabe-KBS; 0 = Zellgröße des DOM.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="296" />
-            <source>Output CRS; default the orientation's. When it differs, the computation runs on the output grid and cell centres are transformed to the orientation's CRS (images are resampled once).</source>
-            <translation>Ausgabe-KBS; Standard ist das der Orientierung. Weicht es ab, läuft die Berechnung auf dem Ausgaberaster, und die Zellmittelpunkte werden in das KBS der Orientierung transformiert (die Bilder werden nur einmal umgebildet).</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="299" />
-            <source>Estimate and apply per-image colour corrections before mosaicking.</source>
-            <translation>Farbkorrekturen je Bild vor der Mosaikbildung schätzen und anwenden.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="300" />
-            <source>With the colour correction: estimate a radial darkening towards the image corners per camera from the overlaps and remove it first. Images without vignetting get a factor of about 1; switch it off for images already corrected in processing.</source>
-            <translation>Mit der Farbkorrektur: je Kamera eine radiale Abdunklung zu den Bildecken aus den Überlappungen schätzen und zuerst entfernen. Bilder ohne Vignettierung erhalten einen Faktor von etwa 1; für bereits bei der Entwicklung korrigierte Bilder ausschalten.</translation>
-        </message>
-        <message>
-            <location filename="../processing/help/__init__.py" line="303" />
             <source>Most cameras store JPEG colour at half the resolution of the brightness (4:2:0 or 4:2:2, read from each file's header), so colours smear across building outlines. When on, the colour edges of such images are restored from the brightness before they are sampled at full resolution. Other images are not changed.</source>
             <translation>Die meisten Kameras speichern die Farbe von JPEGs mit halber Auflösung der Helligkeit (4:2:0 oder 4:2:2, aus dem Kopf jeder Datei gelesen), so dass Farben über Gebäudeumrisse verschmieren. Wenn eingeschaltet, werden die Farbkanten solcher Bilder aus der Helligkeit wiederhergestellt, bevor sie in voller Auflösung abgetastet werden. Andere Bilder bleiben unverändert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="307" />
+            <location filename="../processing/help/__init__.py" line="180" />
+            <source>Where the tiles of dense matching, DSM filtering and the true orthophoto are computed, by one executor for the three stages (a local cluster starts once); the products are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the photos and OUTPUT_FOLDER at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The orientation, the mesh and the report are computed in QGIS's process. The address is checked before the orientation starts; the scheduler is first contacted by dense matching.</source>
+            <translation>Wo die Kacheln der dichten Bildzuordnung, der DOM-Filterung und des True Orthophotos berechnet werden, durch einen Executor für alle drei Schritte (ein lokaler Cluster startet nur einmal); die Produkte sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Fotos und OUTPUT_FOLDER unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Orientierung, Dreiecksnetz und Bericht werden im Prozess von QGIS berechnet. Die Adresse wird vor dem Start der Orientierung geprüft; der Scheduler wird erstmals von der dichten Bildzuordnung kontaktiert.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="191" />
+            <source>Folder of the products (created when missing; existing products are replaced). It holds only products: orientation.json (adjusted orientation), report.html and report.json (the quality report and its data), dsm_raw.tif (DSM as matched, before filtering), confidence.tif (matching confidence 0 to 1), orthoimage.tif (colour of each DSM cell from the matching, not a true orthophoto), dsm.tif (filtered DSM), pointcloud.laz, mesh.ply, trueortho.tif, source_index.tif (which photo each true-orthophoto cell comes from), occlusion.tif and seamlines.gpkg. Caches (compiled kernels, image features) are kept in the per-user cache folder (environment variable TRUORTHO_CACHE_DIR; truortho:environment shows and clears it).</source>
+            <translation>Ordner der Produkte (wird angelegt, falls er fehlt; vorhandene Produkte werden ersetzt). Er enthält nur Produkte: orientation.json (ausgeglichene Orientierung), report.html und report.json (der Qualitätsbericht und seine Daten), dsm_raw.tif (DOM wie zugeordnet, vor der Filterung), confidence.tif (Zuordnungskonfidenz 0 bis 1), orthoimage.tif (Farbe jeder DOM-Zelle aus der Zuordnung, kein True-Orthophoto), dsm.tif (gefiltertes DOM), pointcloud.laz, mesh.ply, trueortho.tif, source_index.tif (aus welchem Foto jede True-Orthophoto-Zelle stammt), occlusion.tif und seamlines.gpkg. Caches (kompilierte Kernel, Bildmerkmale) liegen im benutzereigenen Cache-Ordner (Umgebungsvariable TRUORTHO_CACHE_DIR; truortho:environment zeigt und leert ihn).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="200" />
+            <source>orientation.json: the adjusted orientation.</source>
+            <translation>orientation.json: die ausgeglichene Orientierung.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="201" />
+            <source>report.html (and report.json): the quality report of the run.</source>
+            <translation>report.html (und report.json): der Qualitätsbericht des Laufs.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="202" />
+            <source>dsm.tif: the filtered DSM (float32, nodata -9999).</source>
+            <translation>dsm.tif: das gefilterte DOM (float32, NoData -9999).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="203" />
+            <source>pointcloud.laz: the matched points with colour and confidence.</source>
+            <translation>pointcloud.laz: die zugeordneten Punkte mit Farbe und Konfidenz.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="204" />
+            <source>mesh.ply: 2.5D mesh of the filtered DSM with vertical walls and vertex colours.</source>
+            <translation>mesh.ply: 2,5D-Dreiecksnetz des gefilterten DOM mit senkrechten Wänden und Eckpunktfarben.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="205" />
+            <source>trueortho.tif: the true orthophoto (bands of the photos + alpha, COG).</source>
+            <translation>trueortho.tif: das True Orthophoto (Kanäle der Fotos + Alpha, COG).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="206" />
+            <source>occlusion.tif: 1 where no photo sees the surface.</source>
+            <translation>occlusion.tif: 1, wo kein Foto die Oberfläche sieht.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="207" />
+            <source>seamlines.gpkg: one polygon per source photo.</source>
+            <translation>seamlines.gpkg: ein Polygon je Quellfoto.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="212" />
+            <source>Dense image matching in object space (OSGM): computes a DSM directly on a ground grid from the oriented images, without rectification or pairwise depth maps. For every tile of the grid the images that see it (at most MAX_IMAGES) are resampled onto the horizontal plane of every search height (voxels of RESOLUTION x RESOLUTION x Z_STEP); a matching cost from all of them per cell and height is aggregated by semi-global matching along 8 or 16 paths (penalty P1 for a change of one height step, P2 for larger jumps, lowered across image edges), and each cell takes the height of least aggregated cost, refined between steps, with a confidence in [0, 1]. Matching runs coarse to fine over an image pyramid, by tiles, with progress and cancel. Cells without a reliable match are nodata (filter and fill them with truortho:dsmfilter). Optionally writes the confidence, an orthoimage coloured from the matched images, and a point cloud; with OBLIQUE = auto, groups of oblique images are matched in extra reference systems along their viewing directions, whose points (facades) go to the point cloud.</source>
+            <translation>Dichte Bildzuordnung im Objektraum (OSGM): berechnet ein DOM direkt auf einem Bodenraster aus den orientierten Bildern, ohne Epipolarentzerrung oder paarweise Tiefenkarten. Für jede Kachel des Rasters werden die Bilder, die sie sehen (höchstens MAX_IMAGES), auf die horizontale Ebene jeder Suchhöhe umgebildet (Voxel von RESOLUTION x RESOLUTION x Z_STEP); ein Zuordnungskostenwert aus allen diesen Bildern je Zelle und Höhe wird durch Semi-Global Matching entlang 8 oder 16 Pfaden aggregiert (Strafterm P1 für eine Änderung um einen Höhenschritt, P2 für größere Sprünge, an Bildkanten verringert), und jede Zelle erhält die Höhe mit den geringsten aggregierten Kosten, zwischen den Schritten verfeinert, mit einer Konfidenz in [0, 1]. Die Zuordnung läuft grob-zu-fein über eine Bildpyramide, kachelweise, mit Fortschrittsanzeige und Abbruchmöglichkeit. Zellen ohne zuverlässige Zuordnung sind NoData (mit truortho:dsmfilter filtern und füllen). Optional werden die Konfidenz, ein aus den zugeordneten Bildern eingefärbtes Orthobild und eine Punktwolke geschrieben; mit OBLIQUE = auto werden Gruppen von Schrägbildern in zusätzlichen Referenzsystemen entlang ihrer Blickrichtungen zugeordnet, deren Punkte (Fassaden) in die Punktwolke gehen.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="226" />
+            <source>Orientation JSON (from Orient images or Import orientation) with a projected CRS (metres) and at least two images, which must be on disk.</source>
+            <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren) mit einem projizierten KBS (Meter) und mindestens zwei Bildern, die auf der Festplatte vorhanden sein müssen.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="228" />
+            <source>Area to match (reprojected to the orientation's CRS); default the extent of the sparse points (1-99 %), else the union of the near-nadir image footprints. It must intersect the area the images see.</source>
+            <translation>Zuzuordnender Bereich (in das KBS der Orientierung umprojiziert); Standard ist die Ausdehnung der dünnen Punktwolke (1-99 %), sonst die Vereinigung der Bildabdeckungen der nadirnahen Bilder. Er muss den von den Bildern gesehenen Bereich schneiden.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="231" />
+            <source>Cell size of the DSM, metres; empty or 0 = the median ground sample distance of the near-nadir images.</source>
+            <translation>Zellgröße des DOM, Meter; leer oder 0 = mittlere Bodenpixelgröße (Median) der nadirnahen Bilder.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="233" />
+            <source>Height step between two search planes, metres; empty or 0 = the resolution.</source>
+            <translation>Höhenschritt zwischen zwei Suchebenen, Meter; leer oder 0 = die Auflösung.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="234" />
+            <source>Lowest height searched (world Z, the orientation's vertical datum); empty = from the sparse points (0.5 % percentile minus a margin), else from the GCP heights. Must be below Z_MAX.</source>
+            <translation>Niedrigste gesuchte Höhe (Welt-Z, das Höhendatum der Orientierung); leer = aus der dünnen Punktwolke (0,5-%-Perzentil minus einem Rand), sonst aus den Passpunkthöhen. Muss unter Z_MAX liegen.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="237" />
+            <source>Highest height searched; empty = from the sparse points (99.5 % percentile plus a margin), else half the flying height above the highest GCP. Always kept below the cameras. Without sparse points or GCPs give Z_MIN and Z_MAX.</source>
+            <translation>Höchste gesuchte Höhe; leer = aus der dünnen Punktwolke (99,5-%-Perzentil plus einem Rand), sonst die halbe Flughöhe über dem höchsten Passpunkt. Bleibt immer unterhalb der Kameras. Ohne dünne Punktwolke oder Passpunkte Z_MIN und Z_MAX angeben.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="240" />
+            <source>Optional coarse DSM or DTM raster: the search at each cell is bounded by the lowest and highest height of its neighbourhood plus a margin, which speeds up matching and avoids wrong heights on rough terrain.</source>
+            <translation>Optionales grobes DOM- oder DGM-Raster: die Suche an jeder Zelle wird durch die niedrigste und höchste Höhe ihrer Nachbarschaft plus einen Rand begrenzt, was die Zuordnung beschleunigt und falsche Höhen in rauem Gelände vermeidet.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="243" />
+            <source>Number of aggregation directions of semi-global matching: 16 (the default) or 8 (about 6 % faster; the hillshade of natural terrain then shows a fine cross-hatch along the grid's axes and diagonals).</source>
+            <translation>Anzahl der Aggregationsrichtungen des Semi-Global-Matchings: 16 (Standard) oder 8 (etwa 6 % schneller; die Schummerung natürlichen Geländes zeigt dann ein feines Gittermuster entlang der Achsen und Diagonalen des Rasters).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="246" />
+            <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
+            <translation>none: ein Nadir-Referenzsystem (das DOM). auto: Gruppen von Schrägbildern erhalten zusätzlich Referenzsysteme entlang ihrer Blickrichtungen, deren Punkte mit ihrer 'system'-Kennung in die Punktwolke gehen.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="249" />
+            <source>Penalty for a change of one height step between neighbouring cells, in cost units (unrelated image windows cost 1023); empty = 256.</source>
+            <translation>Strafterm für eine Änderung um einen Höhenschritt zwischen benachbarten Zellen, in Kosteneinheiten (unabhängige Bildfenster kosten 1023); leer = 256.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="251" />
+            <source>Penalty for a larger height jump, above P1 and at most 3072; empty = 2048 (a jump then needs contrary evidence from two cells).</source>
+            <translation>Strafterm für einen größeren Höhensprung, über P1 und höchstens 3072; leer = 2048 (ein Sprung erfordert dann Gegenevidenz aus zwei Zellen).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="253" />
+            <source>Largest number of images matched per tile (best coverage first, then the most nadir; more only where fewer would leave part of the tile with under 2 views); memory and time grow with it.</source>
+            <translation>Größte Anzahl pro Kachel zugeordneter Bilder (beste Abdeckung zuerst, dann die nadirnächsten; mehr nur, wo weniger einen Teil der Kachel mit weniger als 2 Ansichten ließen); Speicherbedarf und Rechenzeit wachsen damit.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="256" />
+            <source>Tile side in cells; memory grows with its square, the number of search heights and MAX_IMAGES.</source>
+            <translation>Kachelseite in Zellen; der Speicherbedarf wächst mit ihrem Quadrat, der Anzahl der Suchhöhen und MAX_IMAGES.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="258" />
+            <source>Where the tiles are matched; the DSM and confidence are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. Finished tiles are kept beside the DSM (DSM.tif.tiles) until the run ends, so a rerun with the same inputs and parameters after a crash reuses them.</source>
+            <translation>Wo die Kacheln zugeordnet werden; DOM und Konfidenz sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Fertige Kacheln werden bis zum Ende des Laufs neben dem DOM aufbewahrt (DSM.tif.tiles), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="267" />
+            <source>The raw DSM: GeoTIFF, float32, in the orientation's CRS, nodata -9999.</source>
+            <translation>Das rohe DOM: GeoTIFF, float32, im KBS der Orientierung, NoData -9999.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="268" />
+            <source>Optional confidence GeoTIFF (float32 in [0, 1], nodata -1) on the DSM grid, for truortho:dsmfilter.</source>
+            <translation>Optionales Konfidenz-GeoTIFF (float32 in [0, 1], NoData -1) auf dem DOM-Raster, für truortho:dsmfilter.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="270" />
+            <source>Optional RGB orthoimage GeoTIFF (uint8, 0 = no data) on the DSM grid, coloured from the matched images; not a true orthophoto (use truortho:trueortho for that).</source>
+            <translation>Optionales RGB-Orthobild als GeoTIFF (uint8, 0 = keine Daten) auf dem DOM-Raster, aus den zugeordneten Bildern eingefärbt; kein True Orthophoto (dafür truortho:trueortho verwenden).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="272" />
+            <source>Optional point cloud (.laz or .las; LAS 1.4 with colours, 'confidence' and 'system', the reference system of each point).</source>
+            <translation>Optionale Punktwolke (.laz oder .las; LAS 1.4 mit Farben, 'confidence' und 'system', dem Referenzsystem jedes Punktes).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="274" />
+            <source>JSON: grid size, resolution, height step and range (and where it came from), pyramid levels, tiles, completeness, mean confidence, reference systems, time.</source>
+            <translation>JSON: Rastergröße, Auflösung, Höhenschritt und -bereich (und woher er stammt), Pyramidenstufen, Kacheln, Vollständigkeit, mittlere Konfidenz, Referenzsysteme, Zeit.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="280" />
+            <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
+            <translation>Berechnet ein True Orthophoto aus orientierten Bildern und einer Oberfläche (einem DOM-Raster wie dem von OSGM oder einem PLY/OBJ-Dreiecksnetz): jede Zelle wird aus einem Bild eingefärbt, das sie wirklich sieht, ermittelt mit einem Tiefenpuffer der Oberfläche je Bild (DOM-Zellen als flache Dächer mit senkrechten Wänden an Höhensprüngen, oder die Dreiecke des Netzes; Frustum- und Rückseiten-Culling). Unter den Bildern, die eine Zelle sehen, wird dasjenige mit der feinsten effektiven Bodenauflösung (Entfernung und Einfallswinkel auf der Oberfläche) bevorzugt; Dächer werden jeweils aus einem einzigen Bild texturiert, und die Nahtlinien folgen Höhensprüngen und meiden Stellen, an denen die Bilder nicht übereinstimmen (Label-Glättung), mit Überblendung über die Nähte nur zwischen Bildern, die beide die Zellen sehen. Farbkorrekturen je Bild in CIE L*a*b* (Verstärkung/Versatz je Kanal für Nicht-RGB-Daten) werden per Ausgleichung nach kleinsten Quadraten aus Zellen geschätzt, die mehrere Bilder sehen. Zellen, die kein Bild sieht, erhalten Alpha 0 und erscheinen in der Verdeckungsmaske. Kanalanzahl und Datentyp der Bilder bleiben erhalten (RGB, 16-Bit-panchromatisch, thermal). Die Verarbeitung läuft kachelweise mit begrenztem Speicher; Fortschritt und Abbruch je Kachel.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="294" />
+            <source>Orientation JSON (from Orient images or Import orientation); its images must be on disk.</source>
+            <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren); seine Bilder müssen auf der Festplatte vorhanden sein.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="296" />
+            <source>DSM GeoTIFF (any CRS; resampled onto the output grid by nearest neighbour) or a PLY/OBJ mesh. Heights must use the orientation's vertical datum. It must cover the extent.</source>
+            <translation>DOM-GeoTIFF (beliebiges KBS; per nächstem Nachbarn auf das Ausgaberaster umgebildet) oder ein PLY/OBJ-Dreiecksnetz. Die Höhen müssen das Höhendatum der Orientierung verwenden. Es muss die Ausdehnung abdecken.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="298" />
+            <source>Output extent; default the surface's extent.</source>
+            <translation>Ausgabeausdehnung; Standard ist die Ausdehnung der Oberfläche.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="299" />
+            <source>Output cell size in units of the output CRS; 0 = the DSM's cell size.</source>
+            <translation>Ausgabezellgröße in Einheiten des Ausgabe-KBS; 0 = Zellgröße des DOM.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="300" />
+            <source>Output CRS; default the orientation's. When it differs, the computation runs on the output grid and cell centres are transformed to the orientation's CRS (images are resampled once).</source>
+            <translation>Ausgabe-KBS; Standard ist das der Orientierung. Weicht es ab, läuft die Berechnung auf dem Ausgaberaster, und die Zellmittelpunkte werden in das KBS der Orientierung transformiert (die Bilder werden nur einmal umgebildet).</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="303" />
+            <source>Estimate and apply per-image colour corrections before mosaicking.</source>
+            <translation>Farbkorrekturen je Bild vor der Mosaikbildung schätzen und anwenden.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="304" />
+            <source>With the colour correction: estimate a radial darkening towards the image corners per camera from the overlaps and remove it first. Images without vignetting get a factor of about 1; switch it off for images already corrected in processing.</source>
+            <translation>Mit der Farbkorrektur: je Kamera eine radiale Abdunklung zu den Bildecken aus den Überlappungen schätzen und zuerst entfernen. Bilder ohne Vignettierung erhalten einen Faktor von etwa 1; für bereits bei der Entwicklung korrigierte Bilder ausschalten.</translation>
+        </message>
+        <message>
+            <location filename="../processing/help/__init__.py" line="311" />
             <source>Largest off-nadir angle of the viewing ray (degrees) for an image to texture a cell; also bounds how far outside a tile occluders are searched.</source>
             <translation>Größter Winkel des Sehstrahls zum Nadir (Grad), unter dem ein Bild eine Zelle texturieren darf; begrenzt auch, wie weit außerhalb einer Kachel nach verdeckenden Objekten gesucht wird.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="309" />
+            <location filename="../processing/help/__init__.py" line="313" />
             <source>Width of the feathering across seamlines, in cells (0 = hard seams).</source>
             <translation>Breite der Überblendung an den Nahtlinien, in Zellen (0 = harte Nähte).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="310" />
+            <location filename="../processing/help/__init__.py" line="314" />
             <source>Tile side in cells; memory grows with its square and the images per tile.</source>
             <translation>Kachelseite in Zellen; der Speicherbedarf wächst mit ihrem Quadrat und den Bildern pro Kachel.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="311" />
+            <location filename="../processing/help/__init__.py" line="315" />
             <source>Compression of the orthophoto. DEFLATE (the default), ZSTD and LZW are lossless: DEFLATE gives the smallest files and every GIS reads it; ZSTD (level 1) writes about twice as fast and about 9 % larger (GDAL 2.3 or later reads it); LZW is for older readers. JPEG is lossy (about a fifth of the size), for 8-bit RGB images only: RGB is stored as YCbCr with halved colour resolution, so colours blur across sharp edges such as building outlines (deliver and view with it; measure on a lossless one), and the alpha band becomes the file's internal mask. The source index and occlusion mask always stay lossless.</source>
             <translation>Kompression des Orthophotos. DEFLATE (Standard), ZSTD und LZW sind verlustfrei: DEFLATE ergibt die kleinsten Dateien und jedes GIS liest es; ZSTD (Stufe 1) schreibt etwa doppelt so schnell und etwa 9 % größer (lesbar ab GDAL 2.3); LZW ist für ältere Leseprogramme. JPEG ist verlustbehaftet (etwa ein Fünftel der Größe), nur für 8-Bit-RGB-Bilder: RGB wird als YCbCr mit halbierter Farbauflösung gespeichert, sodass Farben über scharfe Kanten wie Gebäudeumrisse verschwimmen (zum Ausliefern und Ansehen; gemessen wird an einer verlustfreien Datei), und das Alphaband wird zur internen Maske der Datei. Quellbildindex und Verdeckungsmaske bleiben immer verlustfrei.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="318" />
+            <location filename="../processing/help/__init__.py" line="322" />
             <source>JPEG quality (1-100) when COMPRESSION is JPEG.</source>
             <translation>JPEG-Qualität (1-100), wenn COMPRESSION JPEG ist.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="319" />
+            <location filename="../processing/help/__init__.py" line="323" />
             <source>Where the tiles of the mosaic are computed; the true orthophoto, source index, occlusion mask and seamlines are identical with every choice. inprocess: in QGIS's process, the independent tiles of a wave in parallel threads (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images and the surface at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The colour correction (on a decimated grid) is estimated in QGIS's process. Finished tiles are kept in a folder beside the output (its name plus '.tiles') until the run succeeds, so a rerun with the same inputs and parameters after a crash reuses them.</source>
             <translation>Wo die Kacheln des Mosaiks berechnet werden; True Orthophoto, Quellbildindex, Verdeckungsmaske und Nahtlinien sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, die unabhängigen Kacheln einer Welle parallel in Threads (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder und die Oberfläche unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Der Farbausgleich (auf einem ausgedünnten Raster) wird im Prozess von QGIS geschätzt. Fertige Kacheln werden bis zum erfolgreichen Ende des Laufs in einem Ordner neben der Ausgabe aufbewahrt (ihr Name plus '.tiles'), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="331" />
+            <location filename="../processing/help/__init__.py" line="335" />
             <source>GeoTIFF with the images' bands and data type plus an alpha band (an internal mask with JPEG compression), tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
             <translation>GeoTIFF mit den Bändern und dem Datentyp der Bilder plus einem Alphaband (bei JPEG-Kompression eine interne Maske), gekachelt, mit Übersichten, im Cloud-Optimized-GeoTIFF-Layout.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="333" />
+            <location filename="../processing/help/__init__.py" line="337" />
             <source>Int16 GeoTIFF: index (0-based, orientation order) of the image each cell comes from; -1 = nodata.</source>
             <translation>Int16-GeoTIFF: Index (ab 0, Reihenfolge der Orientierung) des Bildes, aus dem jede Zelle stammt; -1 = NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="335" />
+            <location filename="../processing/help/__init__.py" line="339" />
             <source>UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the surface has no data.</source>
             <translation>UInt8-GeoTIFF: 1, wo kein Bild die Zelle sieht, 0, wo sie gesehen wird, 255, wo die Oberfläche keine Daten hat.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="337" />
+            <location filename="../processing/help/__init__.py" line="341" />
             <source>Polygons, one feature per source image: the cells it colours (image_index, image, cells, area).</source>
             <translation>Polygone, ein Objekt pro Quellbild: die Zellen, die es einfärbt (image_index, image, cells, area).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="343" />
+            <location filename="../processing/help/__init__.py" line="347" />
             <source>Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the cells of blurred height steps to the nearer side, removes outliers (cells that depart from the confidence-weighted median of their window by more than the threshold and have too few neighbours at their height, so roof edges and corners survive), fills holes up to a maximum width by harmonic interpolation (holes at the foot of walls from the ground side only; wider holes stay nodata and are reported), and optionally smooths planar surfaces without blurring their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the statistics (removed outliers, filled cells, remaining holes) are returned and logged.</source>
             <translation>Bereinigt ein rohes DOM (z. B. das DOM der dichten Bildzuordnung aus dem OSGM-Schritt von TruOrtho) kachelweise: schiebt die Zellen verschliffener Höhensprünge auf die nähere Seite, entfernt Ausreißer (Zellen, die um mehr als die Schwelle vom konfidenzgewichteten Median ihres Fensters abweichen und zu wenige Nachbarn auf ihrer Höhe haben, sodass Dachkanten und Ecken erhalten bleiben), füllt Lücken bis zu einer Höchstbreite durch harmonische Interpolation (Lücken am Fuß von Wänden nur von der Bodenseite aus; breitere Lücken bleiben NoData und werden gemeldet) und glättet optional ebene Flächen, ohne ihre Kanten zu verwischen. Optional wird ein Geländemodell (DGM) durch Bodenfilterung nach Art von SMRF abgeleitet sowie das normalisierte DOM (Höhe über Gelände). Die Ausgaben behalten KBS, Raster und NoData der Eingabe; die Statistik (entfernte Ausreißer, gefüllte Zellen, verbleibende Lücken) wird zurückgegeben und protokolliert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="354" />
+            <location filename="../processing/help/__init__.py" line="358" />
             <source>Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.</source>
             <translation>Rohes DOM: einkanaliges Raster mit einem projizierten KBS (Meter); seine NoData-Zellen sind Lücken.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="355" />
+            <location filename="../processing/help/__init__.py" line="359" />
             <source>Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum confidence are removed, less confident cells must agree better with their neighbours, and the median is weighted by confidence.</source>
             <translation>Optionales Konfidenzraster in [0, 1] (CONFIDENCE von OSGM): Zellen unter der Mindestkonfidenz werden entfernt, weniger zuverlässige Zellen müssen besser mit ihren Nachbarn übereinstimmen, und der Median wird mit der Konfidenz gewichtet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="358" />
+            <location filename="../processing/help/__init__.py" line="362" />
             <source>Largest departure from the neighbourhood median, metres (empty: 4 x the resolution).</source>
             <translation>Größte Abweichung vom Median der Nachbarschaft, Meter (leer: 4 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="360" />
+            <location filename="../processing/help/__init__.py" line="364" />
             <source>Side of the median window in cells (odd); a second pass uses twice the window.</source>
             <translation>Seitenlänge des Medianfensters in Zellen (ungerade); ein zweiter Durchlauf verwendet das doppelte Fenster.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="362" />
+            <location filename="../processing/help/__init__.py" line="366" />
             <source>Neighbours within the threshold of a cell's height that keep it although it departs from the median (edges, corners, thin structures).</source>
             <translation>Nachbarn innerhalb der Schwelle um die Höhe einer Zelle, die sie erhalten, obwohl sie vom Median abweicht (Kanten, Ecken, dünne Strukturen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="364" />
+            <location filename="../processing/help/__init__.py" line="368" />
             <source>With a confidence raster: cells below this confidence are removed.</source>
             <translation>Mit einem Konfidenzraster: Zellen unter dieser Konfidenz werden entfernt.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="365" />
+            <location filename="../processing/help/__init__.py" line="369" />
             <source>With a confidence raster: less confident cells are removed when they depart by more than the threshold from the median of the cells at least this confident in their 15 x 15 window (0: off).</source>
             <translation>Mit einem Konfidenzraster: weniger zuverlässige Zellen werden entfernt, wenn sie um mehr als die Schwelle vom Median der Zellen mit mindestens dieser Konfidenz in ihrem 15-x-15-Fenster abweichen (0: aus).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="368" />
+            <location filename="../processing/help/__init__.py" line="372" />
             <source>Largest hole width (metres) that is interpolated; 0 fills nothing.</source>
             <translation>Größte Lückenbreite (Meter), die interpoliert wird; 0 füllt nichts.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="369" />
+            <location filename="../processing/help/__init__.py" line="373" />
             <source>Height difference between two surfaces (a wall), metres: hole boundary cells that much above nearby boundary cells are not interpolated from.</source>
             <translation>Höhenunterschied zwischen zwei Oberflächen (eine Wand), Meter: Randzellen einer Lücke, die so viel höher als benachbarte Randzellen liegen, werden nicht zur Interpolation verwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="371" />
+            <location filename="../processing/help/__init__.py" line="375" />
             <source>Snap the cells of blurred height steps (between the two levels of their 5 x 5 window) to the nearer level.</source>
             <translation>Die Zellen verschliffener Höhensprünge (zwischen den beiden Niveaus ihres 5-x-5-Fensters) auf das nähere Niveau schieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="373" />
+            <location filename="../processing/help/__init__.py" line="377" />
             <source>Replace cells by a local plane fitted to the neighbours at their height (flat and pitched roofs, streets); steps stay sharp.</source>
             <translation>Zellen durch eine lokale Ebene ersetzen, die an die Nachbarn auf ihrer Höhe angepasst ist (Flach- und Schrägdächer, Straßen); Sprünge bleiben scharf.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="375" />
+            <location filename="../processing/help/__init__.py" line="379" />
             <source>Radius of the smoothing neighbourhood, cells.</source>
             <translation>Radius der Glättungsnachbarschaft, Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="376" />
+            <location filename="../processing/help/__init__.py" line="380" />
             <source>Neighbours within this height of a cell belong to its surface, metres (empty: 2.5 x the resolution).</source>
             <translation>Nachbarn innerhalb dieser Höhe um eine Zelle gehören zu ihrer Oberfläche, Meter (leer: 2,5 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="378" />
+            <location filename="../processing/help/__init__.py" line="382" />
             <source>Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); the DTM is written on the DSM grid.</source>
             <translation>Zellgröße des Bodenfilters, Meter (leer: max(1 m, DOM-Auflösung)); das DGM wird auf dem DOM-Raster geschrieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="380" />
+            <location filename="../processing/help/__init__.py" line="384" />
             <source>Largest opening radius of the ground filter, metres: more than half the width of the largest building.</source>
             <translation>Größter Öffnungsradius des Bodenfilters, Meter: mehr als die halbe Breite des größten Gebäudes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="382" />
+            <location filename="../processing/help/__init__.py" line="386" />
             <source>Terrain slope (rise over run) the ground filter keeps as ground.</source>
             <translation>Geländeneigung (Höhe pro Strecke), die der Bodenfilter als Boden behält.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="383" />
+            <location filename="../processing/help/__init__.py" line="387" />
             <source>Where the tiles are filtered; the filtered DSM and the statistics are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The terrain model is computed in QGIS's process.</source>
             <translation>Wo die Kacheln gefiltert werden; gefiltertes DOM und Statistik sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen das DOM und das Konfidenzraster unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Das Geländemodell wird im Prozess von QGIS berechnet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="391" />
+            <location filename="../processing/help/__init__.py" line="395" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>Gefiltertes DOM (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="392" />
+            <location filename="../processing/help/__init__.py" line="396" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Optionales Geländemodell (GeoTIFF, float32, DOM-Raster).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="393" />
+            <location filename="../processing/help/__init__.py" line="397" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>Optionales normalisiertes DOM: DOM minus DGM, Höhen über dem Gelände.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="394" />
+            <location filename="../processing/help/__init__.py" line="398" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON: die Filterstatistik (und die des Bodenfilters).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="395" />
+            <location filename="../processing/help/__init__.py" line="399" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Als Ausreißer oder wegen geringer Konfidenz entfernte Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="396" />
+            <location filename="../processing/help/__init__.py" line="400" />
             <source>Hole cells interpolated.</source>
             <translation>Interpolierte Lückenzellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="397" />
+            <location filename="../processing/help/__init__.py" line="401" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Lücken, breiter als MAX_HOLE, als NoData belassen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="402" />
+            <location filename="../processing/help/__init__.py" line="406" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Erzeugt eine Dreiecksvermaschung. Aus einem DOM: ein 2,5D-Netz, dessen Höhensprünge senkrechte Wände sind (kein Dreieck überspannt je einen Sprung) und dessen ebene und glatte Bereiche durch einen eingeschränkten Quadtree mit garantierter Höhenfehlerschranke an jedem Zellmittelpunkt ausgedünnt werden; Eckpunktfarben aus einem optionalen Orthobild. Aus einer Punktwolke (LAS/LAZ oder EPT, z. B. zusammengeführte Zuordnung von Schrägbildern): ein 2,5D-Delaunay-Netz je Referenzsystem, entlang seiner Blickrichtung gesehen (überlappende Schichten, wo Systeme dieselbe Oberfläche sehen; nicht wasserdicht). Schreibt PLY (binär) oder OBJ, im KBS oder in einem lokalen System, dessen Offset im Dateikopf vermerkt ist; truortho:trueortho liest es als SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="411" />
+            <location filename="../processing/help/__init__.py" line="415" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>DOM-Raster (projiziertes KBS) oder Punktwolke (.las, .laz oder eine EPT-ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="412" />
+            <location filename="../processing/help/__init__.py" line="416" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Optionales Orthobild (RGB) für die Eckpunktfarben eines DOM-Netzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="413" />
+            <location filename="../processing/help/__init__.py" line="417" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Größter Höhenunterschied zwischen Netz und DOM an einem Zellmittelpunkt, Meter (leer: halbe DOM-Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="415" />
+            <location filename="../processing/help/__init__.py" line="419" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Kleinster Höhenunterschied zwischen benachbarten Zellen, der zur Wand wird, Meter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="416" />
+            <location filename="../processing/help/__init__.py" line="420" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Steilste als geneigte Dreiecke erhaltene Neigung, Grad: die Sprungschwelle ist max(MIN_STEP, Auflösung x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="418" />
+            <location filename="../processing/help/__init__.py" line="422" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Größter Zellblock, den ein Dreieckspaar abdecken darf (eine Zweierpotenz).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="419" />
+            <location filename="../processing/help/__init__.py" line="423" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Punktwolken: längste Dreieckskante, Meter (leer: 4 x der mittlere Punktabstand).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="420" />
+            <location filename="../processing/help/__init__.py" line="424" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>CRS: Weltkoordinaten (PLY-Doubles). Lokal: Welt minus einem Offset, vermerkt als 'comment offset E N H' (PLY) oder '# offset E N H' (OBJ), für Viewer, die kleine Zahlen benötigen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="422" />
+            <location filename="../processing/help/__init__.py" line="426" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Das Netz: .ply (binär, Little-Endian, 'comment crs ...') oder .obj ('# crs ...', Eckpunktfarben als 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="424" />
+            <location filename="../processing/help/__init__.py" line="428" />
             <source>Number of vertices.</source>
             <translation>Anzahl der Eckpunkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="425" />
+            <location filename="../processing/help/__init__.py" line="429" />
             <source>Number of triangles.</source>
             <translation>Anzahl der Dreiecke.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="426" />
+            <location filename="../processing/help/__init__.py" line="430" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Anzahl der senkrechten Wanddreiecke (DOM-Netze).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="431" />
+            <location filename="../processing/help/__init__.py" line="435" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (menu Layer, Add Layer, Add Point Cloud Layer; choose ept.json).</source>
             <translation>Exportiert ein DOM als Punktwolke, ein Punkt je gültigem Zellmittelpunkt, mit Farben aus einem Orthobild und Konfidenz je Punkt aus einem Konfidenzraster: LAS 1.4 oder LAZ (Punktformat 7, KBS als WKT, Zusatzdimensionen 'confidence' und 'system' (das Referenzsystem), ein TruOrtho-VLR, der die Referenzsysteme beschreibt), lesbar mit PDAL, laspy, LAStools und CloudCompare. Daneben wird ein Entwine-Point-Tile-Datensatz (EPT) geschrieben: QGIS-Builds ohne PDAL (wie das QGIS 3.22 von Debian) öffnen ihn als Punktwolken-Layer (Menü Layer, Layer hinzufügen, Punktwolken-Layer hinzufügen; ept.json wählen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="440" />
+            <location filename="../processing/help/__init__.py" line="444" />
             <source>DSM raster with a projected CRS.</source>
             <translation>DOM-Raster mit einem projizierten KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="441" />
+            <location filename="../processing/help/__init__.py" line="445" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Optionales Orthobild (RGB) für die Punktfarben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="442" />
+            <location filename="../processing/help/__init__.py" line="446" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Optionales Konfidenzraster in [0, 1], gespeichert als Dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="443" />
+            <location filename="../processing/help/__init__.py" line="447" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Die Punktwolke (.laz komprimiert oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="444" />
+            <location filename="../processing/help/__init__.py" line="448" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Ordner des EPT-Datensatzes (ept.json, ept-data/, ept-hierarchy/); leer lassen, um ihn zu überspringen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="445" />
+            <location filename="../processing/help/__init__.py" line="449" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Pfad der ept.json des EPT-Datensatzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="446" />
+            <location filename="../processing/help/__init__.py" line="450" />
             <source>Number of points written.</source>
             <translation>Anzahl der geschriebenen Punkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="451" />
+            <location filename="../processing/help/__init__.py" line="455" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Führt Punktwolken mehrerer Referenzsysteme (z. B. das Nadir- und die Schrägsysteme der dichten Bildzuordnung) in einer LAS-1.4-/LAZ-Datei zusammen und behält dabei 'system' jedes Punktes (Dateien ohne dieses Attribut erhalten den Index ihrer Datei) und seine Konfidenz; dünnt optional Duplikate auf einem Voxelgitter aus und behält den zuverlässigsten Punkt jedes Voxels; schreibt optional einen EPT-Datensatz für QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="457" />
+            <location filename="../processing/help/__init__.py" line="461" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>LAS/LAZ-Dateien in einem KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="458" />
+            <location filename="../processing/help/__init__.py" line="462" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Voxelgröße für das Ausdünnen, Meter (leer: jeden Punkt behalten).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="459" />
+            <location filename="../processing/help/__init__.py" line="463" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Die zusammengeführte Punktwolke (.laz oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="460" />
+            <location filename="../processing/help/__init__.py" line="464" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Optionaler Ordner für einen EPT-Datensatz der zusammengeführten Wolke.</translation>
         </message>

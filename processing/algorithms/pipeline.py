@@ -36,12 +36,14 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
     CRS = "CRS"
     RESOLUTION = "RESOLUTION"
     REUSE_ORIENTATION = "REUSE_ORIENTATION"
+    RESTORE_CHROMA = "RESTORE_CHROMA"
     EXECUTOR = "EXECUTOR"
     SCHEDULER_ADDRESS = "SCHEDULER_ADDRESS"
     OUTPUT_FOLDER = "OUTPUT_FOLDER"
     CONFIG_DEFAULTS = {
         RESOLUTION: FromConfig("workflow.WorkflowConfig", "resolution", none=0.0),
         REUSE_ORIENTATION: FromConfig("workflow.WorkflowConfig", "reuse_orientation"),
+        RESTORE_CHROMA: FromConfig("ortho.pipeline.TrueOrthoConfig", "restore_chroma"),
         EXECUTOR: executor_default("workflow.WorkflowConfig"),
     }
     # outputs (files named in truortho.core.workflow.PRODUCTS)
@@ -86,6 +88,14 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
                 self.default(self.REUSE_ORIENTATION),
             )
         )
+        self.add(
+            QgsProcessingParameterBoolean(
+                self.RESTORE_CHROMA,
+                tr("Restore the colour edges of JPEGs with half-resolution colour"),
+                self.default(self.RESTORE_CHROMA),
+            ),
+            advanced=True,
+        )
         self.add_executor()
         self.add(QgsProcessingParameterFolderDestination(self.OUTPUT_FOLDER, tr("Output folder")))
         names = {
@@ -122,6 +132,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
 
     @core_errors()
     def processAlgorithm(self, parameters, context, feedback):  # noqa: N802 - QGIS API
+        from ...core.ortho.pipeline import TrueOrthoConfig
         from ...core.workflow import WorkflowConfig, run_workflow
 
         out_folder = self.parameterAsString(parameters, self.OUTPUT_FOLDER, context)
@@ -142,6 +153,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
             resolution=res if res > 0 else None,
             camera_file=self.parameterAsFile(parameters, self.CAMERA, context) or None,
             reuse_orientation=reuse,
+            ortho=TrueOrthoConfig(restore_chroma=self.parameterAsBool(parameters, self.RESTORE_CHROMA, context)),
             # one executor for OSGM, the DSM filter and the true orthophoto (made and closed by run_workflow)
             executor=executor_kind,
             scheduler_address=address,

@@ -173,6 +173,10 @@ HELP: dict[str, dict] = {
             "sample distance of the near-nadir images.",
             "REUSE_ORIENTATION": "Skip the orientation when OUTPUT_FOLDER already holds orientation.json "
             "(e.g. to rerun matching and the orthophoto with another resolution).",
+            "RESTORE_CHROMA": "Most cameras store JPEG colour at half the resolution of the brightness "
+            "(4:2:0 or 4:2:2, read from each file's header), so colours smear across building outlines. "
+            "When on, the colour edges of such images are restored from the brightness before they are "
+            "sampled at full resolution. Other images are not changed.",
             "EXECUTOR": "Where the tiles of dense matching, DSM filtering and the true orthophoto are "
             "computed, by one executor for the three stages (a local cluster starts once); the products "
             "are identical with every choice. inprocess: in QGIS's process, one tile after the other on "

@@ -81,6 +81,34 @@ def test_pipeline_executor_parameters(truortho_provider):
         assert p.flags() & QgsProcessingParameterDefinition.FlagAdvanced, p.name()
 
 
+def test_pipeline_restore_chroma_reaches_the_true_ortho(truortho_provider, monkeypatch, tmp_path):
+    """RESTORE_CHROMA (advanced, default on, as truortho:trueortho's) is handed to the workflow's
+    true-ortho stage."""
+    import processing
+    from qgis.core import QgsApplication, QgsProcessingParameterDefinition
+
+    from truortho.core import workflow
+
+    alg = QgsApplication.processingRegistry().algorithmById("truortho:pipeline")
+    p = alg.parameterDefinition("RESTORE_CHROMA")
+    assert p.defaultValue() is True and p.flags() & QgsProcessingParameterDefinition.FlagAdvanced
+    seen = []
+
+    def fake(images, folder, gcps, crs, cfg, progress):
+        seen.append(cfg.ortho.restore_chroma)
+        raise workflow.InputError("stop here")
+
+    monkeypatch.setattr(workflow, "run_workflow", fake)
+    (tmp_path / "images").mkdir()
+    for on in (False, True):
+        with pytest.raises(QgsProcessingException, match="stop here"):
+            processing.run(
+                "truortho:pipeline",
+                {"IMAGES": str(tmp_path / "images"), "RESTORE_CHROMA": on, "OUTPUT_FOLDER": str(tmp_path / "o")},
+            )
+    assert seen == [False, True]
+
+
 def test_pipeline_bad_input(truortho_provider, block, tmp_path):
     import processing
 
