@@ -74,24 +74,30 @@ PASSES = REACH + 2
 AFFECT = 2 * (REACH + 2)
 
 
-@njit
+#: Cells per parallel chunk of :func:`_side_heights`.
+_SIDE_CHUNK = 256
+
+
+@pjit
 def _side_heights(z, rows_idx, cols_idx, w, lo_out, hi_out, mid_out):
     """Median of the low and of the high heights in the window of each listed cell."""
-    buf = np.empty((2 * w + 1) ** 2)
-    for n in range(rows_idx.shape[0]):
-        k = _finite_window(z, rows_idx[n], cols_idx[n], w, buf)
-        if k == 0:
-            lo_out[n] = np.nan
-            hi_out[n] = np.nan
-            mid_out[n] = np.nan
-            continue
-        vals = buf[:k]
-        zmin = vals.min()
-        zmax = vals.max()
-        mid = 0.5 * (zmin + zmax)
-        lo_out[n] = np.median(vals[vals <= mid])
-        hi_out[n] = np.median(vals[vals > mid]) if zmax > mid else zmax
-        mid_out[n] = mid
+    n_cells = rows_idx.shape[0]
+    for ch in prange((n_cells + _SIDE_CHUNK - 1) // _SIDE_CHUNK):
+        buf = np.empty((2 * w + 1) ** 2)
+        for n in range(ch * _SIDE_CHUNK, min(n_cells, (ch + 1) * _SIDE_CHUNK)):
+            k = _finite_window(z, rows_idx[n], cols_idx[n], w, buf)
+            if k == 0:
+                lo_out[n] = np.nan
+                hi_out[n] = np.nan
+                mid_out[n] = np.nan
+                continue
+            vals = buf[:k]
+            zmin = vals.min()
+            zmax = vals.max()
+            mid = 0.5 * (zmin + zmax)
+            lo_out[n] = np.median(vals[vals <= mid])
+            hi_out[n] = np.median(vals[vals > mid]) if zmax > mid else zmax
+            mid_out[n] = mid
 
 
 #: Cells per side of the blocks whose highest height lets the visibility march skip a block the ray
@@ -205,6 +211,80 @@ def _samples(img, P: np.ndarray) -> np.ndarray:
     return out.ravel()[:n]
 
 
+@njit
+def _mean32(a, b):
+    """Mean absolute difference of two float32 patches, summed as numpy sums a contiguous row
+    (pairwise, eight accumulators from eight values on), so that it equals
+    ``np.abs(a - b).mean()`` to the bit."""
+    t = a.shape[0]
+    if t < 8:
+        res = np.float32(0.0)
+        for q in range(t):
+            res += np.float32(abs(a[q] - b[q]))
+    else:
+        r0 = np.float32(abs(a[0] - b[0]))
+        r1 = np.float32(abs(a[1] - b[1]))
+        r2 = np.float32(abs(a[2] - b[2]))
+        r3 = np.float32(abs(a[3] - b[3]))
+        r4 = np.float32(abs(a[4] - b[4]))
+        r5 = np.float32(abs(a[5] - b[5]))
+        r6 = np.float32(abs(a[6] - b[6]))
+        r7 = np.float32(abs(a[7] - b[7]))
+        i = 8
+        while i < t - t % 8:
+            r0 += np.float32(abs(a[i] - b[i]))
+            r1 += np.float32(abs(a[i + 1] - b[i + 1]))
+            r2 += np.float32(abs(a[i + 2] - b[i + 2]))
+            r3 += np.float32(abs(a[i + 3] - b[i + 3]))
+            r4 += np.float32(abs(a[i + 4] - b[i + 4]))
+            r5 += np.float32(abs(a[i + 5] - b[i + 5]))
+            r6 += np.float32(abs(a[i + 6] - b[i + 6]))
+            r7 += np.float32(abs(a[i + 7] - b[i + 7]))
+            i += 8
+        res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+        while i < t:
+            res += np.float32(abs(a[i] - b[i]))
+            i += 1
+    return res / np.float32(t)
+
+
+#: Cells per parallel chunk of :func:`_consistency_kernel`.
+_PAIR_CHUNK = 256
+
+
+@pjit
+def _consistency_kernel(samples, visible, cost, pairs):
+    V, N, T = samples.shape
+    for ch in prange((N + _PAIR_CHUNK - 1) // _PAIR_CHUNK):
+        buf = np.empty(max(1, V * (V - 1) // 2), np.float64)
+        ok = np.empty(V, np.bool_)
+        for n in range(ch * _PAIR_CHUNK, min(N, (ch + 1) * _PAIR_CHUNK)):
+            for i in range(V):
+                good = visible[i, n]
+                for q in range(T):
+                    if not np.isfinite(samples[i, n, q]):
+                        good = False
+                ok[i] = good
+            m = 0
+            for i in range(V):
+                if not ok[i]:
+                    continue
+                for j in range(i + 1, V):
+                    if ok[j]:
+                        buf[m] = np.float64(_mean32(samples[i, n], samples[j, n]))
+                        m += 1
+            pairs[n] = m
+            if m == 0:
+                cost[n] = np.inf
+                continue
+            buf[:m].sort()
+            k = max((m + 1) // 2, 1)
+            acc = 0.0
+            for q in range(k):
+                acc += buf[q]
+            cost[n] = acc / k
+
+
 def _consistency(samples: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Mean of the better half of the pair differences: ``(cost (N,), pairs (N,))``.
 
@@ -212,23 +292,16 @@ def _consistency(samples: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, 
     mean absolute difference of its two patches; over ``p`` pairs with both views visible, the
     cost is the mean of the ``max(1, ceil(p / 2))`` smallest (inf without a pair).
     """
-    V, N, _ = samples.shape
-    ok = visible & np.isfinite(samples).all(axis=2)
-    diffs = []
-    for i in range(V):
-        for j in range(i + 1, V):
-            both = ok[i] & ok[j]
-            d = np.full(N, np.inf)
-            if both.any():
-                d[both] = np.abs(samples[i, both] - samples[j, both]).mean(axis=1)
-            diffs.append(d)
-    if not diffs:
-        return np.full(N, np.inf), np.zeros(N, np.int64)
-    D = np.sort(np.asarray(diffs), axis=0)  # (pairs, N), inf last
-    pairs = np.isfinite(D).sum(axis=0).astype(np.int64)
-    k = np.maximum((pairs + 1) // 2, 1)
-    csum = np.cumsum(np.where(np.isfinite(D), D, 0.0), axis=0)
-    cost = np.where(pairs > 0, csum[k - 1, np.arange(N)] / k, np.inf)
+    samples = np.ascontiguousarray(samples, np.float32)
+    visible = np.ascontiguousarray(visible, np.bool_)
+    if samples.ndim != 3 or visible.shape != samples.shape[:2]:
+        raise InputError(
+            f"_consistency: expected samples (V, N, T) and visible (V, N), got {samples.shape}, {visible.shape}"
+        )
+    N = samples.shape[1]
+    cost = np.empty(N, np.float64)
+    pairs = np.zeros(N, np.int64)
+    _consistency_kernel(samples, visible, cost, pairs)
     return cost, pairs
 
 
