@@ -296,7 +296,8 @@ def _consistency(samples: np.ndarray, visible: np.ndarray) -> tuple[np.ndarray, 
     visible = np.ascontiguousarray(visible, np.bool_)
     if samples.ndim != 3 or visible.shape != samples.shape[:2]:
         raise InputError(
-            f"_consistency: expected samples (V, N, T) and visible (V, N), got {samples.shape}, {visible.shape}"
+            "_consistency: expected samples (V, N, T) and visible (V, N), "
+            f"got {samples.shape}, {visible.shape}"
         )
     N = samples.shape[1]
     cost = np.empty(N, np.float64)

@@ -153,7 +153,9 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
             resolution=res if res > 0 else None,
             camera_file=self.parameterAsFile(parameters, self.CAMERA, context) or None,
             reuse_orientation=reuse,
-            ortho=TrueOrthoConfig(restore_chroma=self.parameterAsBool(parameters, self.RESTORE_CHROMA, context)),
+            ortho=TrueOrthoConfig(
+                restore_chroma=self.parameterAsBool(parameters, self.RESTORE_CHROMA, context)
+            ),
             # one executor for OSGM, the DSM filter and the true orthophoto (made and closed by run_workflow)
             executor=executor_kind,
             scheduler_address=address,

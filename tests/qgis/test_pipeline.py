@@ -104,7 +104,8 @@ def test_pipeline_restore_chroma_reaches_the_true_ortho(truortho_provider, monke
         with pytest.raises(QgsProcessingException, match="stop here"):
             processing.run(
                 "truortho:pipeline",
-                {"IMAGES": str(tmp_path / "images"), "RESTORE_CHROMA": on, "OUTPUT_FOLDER": str(tmp_path / "o")},
+                {"IMAGES": str(tmp_path / "images"), "RESTORE_CHROMA": on,
+                 "OUTPUT_FOLDER": str(tmp_path / "o")},  # fmt: skip
             )
     assert seen == [False, True]
 
