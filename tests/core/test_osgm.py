@@ -112,6 +112,18 @@ def test_the_finest_level_tiles_overlap_less():
     assert level_overlap(256, 0) < level_overlap(256, 1)
 
 
+def test_coarse_levels_keep_near_ties():
+    """Only the finest level rejects near-ties (uniqueness); coarser levels keep them as guides,
+    with P2 scaled to their cells and no edge refinement."""
+    grid = RasterGrid(0.0, 100.0, 0.25, 400, 400)
+    plan = plan_levels(-5.0, 55.0, 0.25, grid)
+    params = OsgmConfig(uniqueness=0.9).tile_params()
+    assert plan.level_params(params, 0) == params
+    for lv in (1, 2):
+        p = plan.level_params(params, lv)
+        assert p.uniqueness == 1.0 and p.p2 == round(params.p2 / 2**lv) and not p.edges
+
+
 def test_refined_bands_skip_the_heights_between_two_surfaces():
     grid = RasterGrid(0.0, 100.0, 0.25, 400, 400)
     plan = plan_levels(-5.0, 55.0, 0.25, grid)
