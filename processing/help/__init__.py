@@ -230,7 +230,9 @@ HELP: dict[str, dict] = {
             "the area the images see.",
             "RESOLUTION": "Cell size of the DSM, metres; empty or 0 = the median ground sample distance of "
             "the near-nadir images.",
-            "Z_STEP": "Height step between two search planes, metres; empty or 0 = the resolution.",
+            "Z_STEP": "Height step between two search planes, metres; empty or 0 = the resolution. A "
+            "larger step (1.5 x the resolution) is about 10 % faster, with crisper building edges and "
+            "fewer holes, and noisier on flat ground.",
             "Z_MIN": "Lowest height searched (world Z, the orientation's vertical datum); empty = from the "
             "sparse points (0.5 % percentile minus a margin), else from the GCP heights. Must be below "
             "Z_MAX.",
