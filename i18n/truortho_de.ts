@@ -4,62 +4,67 @@
     <context>
         <name>TruOrtho</name>
         <message>
-            <location filename="../processing/algorithms/base.py" line="20" />
+            <location filename="../processing/algorithms/base.py" line="21" />
             <source>Orientation</source>
             <translation>Orientierung</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="20" />
+            <location filename="../processing/algorithms/base.py" line="21" />
             <source>Orthophoto</source>
             <translation>Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="20" />
+            <location filename="../processing/algorithms/base.py" line="21" />
             <source>Surface</source>
             <translation>Oberfläche</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="20" />
+            <location filename="../processing/algorithms/base.py" line="21" />
             <source>Tools</source>
             <translation>Werkzeuge</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="161" />
+            <location filename="../processing/algorithms/base.py" line="158" />
+            <source>Restore the colour edges of JPEGs with half-resolution colour</source>
+            <translation>Farbkanten von JPEGs mit halbierter Farbauflösung wiederherstellen</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/base.py" line="173" />
             <source>Run tiles on</source>
             <translation>Kacheln ausführen auf</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="174" />
+            <location filename="../processing/algorithms/base.py" line="186" />
             <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
             <translation>Adresse des Dask-Schedulers (tls://host:port oder Scheduler-Datei; leer = TRUORTHO_DASK_SCHEDULER)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="194" />
+            <location filename="../processing/algorithms/base.py" line="206" />
             <source>Ground control points</source>
             <translation>Passpunkte</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="200" />
+            <location filename="../processing/algorithms/base.py" line="212" />
             <source>GCP image measurements (table)</source>
             <translation>Bildmessungen der Passpunkte (Tabelle)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="119" />
+            <location filename="../processing/algorithms/base.py" line="120" />
             <source>TruOrtho algorithms could not be loaded: {}</source>
             <translation>TruOrtho-Algorithmen konnten nicht geladen werden: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="163" />
+            <location filename="../processing/algorithms/base.py" line="175" />
             <source>inprocess: this process (all cores)</source>
             <translation>inprocess: dieser Prozess (alle Kerne)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="164" />
+            <location filename="../processing/algorithms/base.py" line="176" />
             <source>local: a Dask cluster of worker processes on this computer</source>
             <translation>local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="165" />
+            <location filename="../processing/algorithms/base.py" line="177" />
             <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
             <translation>scheduler: ein Dask-Scheduler (SCHEDULER_ADDRESS)</translation>
         </message>
@@ -824,22 +829,22 @@
             <translation>Fotos zum True Orthophoto (gesamte Prozesskette)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="104" />
+            <location filename="../processing/algorithms/pipeline.py" line="97" />
             <source>DSM (filtered)</source>
             <translation>DOM (gefiltert)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="107" />
+            <location filename="../processing/algorithms/pipeline.py" line="100" />
             <source>True orthophoto</source>
             <translation>True Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="108" />
+            <location filename="../processing/algorithms/pipeline.py" line="101" />
             <source>Occlusion mask</source>
             <translation>Verdeckungsmaske</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="109" />
+            <location filename="../processing/algorithms/pipeline.py" line="102" />
             <source>Seamlines</source>
             <translation>Nahtlinien</translation>
         </message>
@@ -854,52 +859,47 @@
             <translation>Eine vorhandene orientation.json im Ausgabeordner wiederverwenden</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="94" />
-            <source>Restore the colour edges of JPEGs with half-resolution colour</source>
-            <translation>Farbkanten von JPEGs mit halbierter Farbauflösung wiederherstellen</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/pipeline.py" line="124" />
+            <location filename="../processing/algorithms/pipeline.py" line="117" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES: geben Sie den Ordner der Fotos an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="140" />
+            <location filename="../processing/algorithms/pipeline.py" line="133" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER: geben Sie einen Ordner für die Produkte an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="150" />
+            <location filename="../processing/algorithms/pipeline.py" line="143" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION: positive Anzahl Meter oder 0 erwartet</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="189" />
+            <location filename="../processing/algorithms/pipeline.py" line="182" />
             <source>DSM (TruOrtho)</source>
             <translation>DOM (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="190" />
+            <location filename="../processing/algorithms/pipeline.py" line="183" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>True Orthophoto (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="191" />
+            <location filename="../processing/algorithms/pipeline.py" line="184" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Verdeckung (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="192" />
+            <location filename="../processing/algorithms/pipeline.py" line="185" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Nahtlinien (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="173" />
+            <location filename="../processing/algorithms/pipeline.py" line="166" />
             <source>Tiles ran on: {}</source>
             <translation>Kacheln berechnet auf: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="172" />
+            <location filename="../processing/algorithms/pipeline.py" line="165" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{}: {:.1f} s, Spitze {:.0f} MB; {}</translation>
         </message>
@@ -1004,37 +1004,37 @@
             <translation>Vignettierung entfernen (mit der Farbkorrektur)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="130" />
+            <location filename="../processing/algorithms/trueortho.py" line="123" />
             <source>Maximum off-nadir viewing angle (degrees)</source>
             <translation>Größter Blickwinkel zum Nadir (Grad)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="140" />
+            <location filename="../processing/algorithms/trueortho.py" line="133" />
             <source>Blend width across seamlines (cells)</source>
             <translation>Überblendungsbreite an den Nahtlinien (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="161" />
+            <location filename="../processing/algorithms/trueortho.py" line="154" />
             <source>Compression of the orthophoto</source>
             <translation>Kompression des Orthophotos</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="174" />
+            <location filename="../processing/algorithms/trueortho.py" line="167" />
             <source>JPEG quality</source>
             <translation>JPEG-Qualität</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="186" />
+            <location filename="../processing/algorithms/trueortho.py" line="179" />
             <source>Source image index</source>
             <translation>Index des Quellbilds</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="197" />
+            <location filename="../processing/algorithms/trueortho.py" line="190" />
             <source>Seamlines (source image regions)</source>
             <translation>Nahtlinien (Bereiche der Quellbilder)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="212" />
+            <location filename="../processing/algorithms/trueortho.py" line="205" />
             <source>SURFACE: give a DSM raster or a mesh file</source>
             <translation>SURFACE: geben Sie ein DOM-Raster oder eine Netzdatei an</translation>
         </message>
@@ -1044,27 +1044,27 @@
             <translation>Oberflächen (*.tif *.tiff *.vrt *.ply *.obj);;Alle Dateien (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="247" />
+            <location filename="../processing/algorithms/trueortho.py" line="240" />
             <source>{} x {} cells, {} images used, coverage {:.2%}, {} cells seen by no image</source>
             <translation>{} x {} Zellen, {} Bilder verwendet, Abdeckung {:.2%}, {} Zellen von keinem Bild gesehen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="163" />
+            <location filename="../processing/algorithms/trueortho.py" line="156" />
             <source>DEFLATE (lossless, read by every GIS)</source>
             <translation>DEFLATE (verlustfrei, von jedem GIS gelesen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="164" />
+            <location filename="../processing/algorithms/trueortho.py" line="157" />
             <source>ZSTD (lossless, fastest to write, larger)</source>
             <translation>ZSTD (verlustfrei, am schnellsten geschrieben, größer)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="165" />
+            <location filename="../processing/algorithms/trueortho.py" line="158" />
             <source>LZW (lossless)</source>
             <translation>LZW (verlustfrei)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="166" />
+            <location filename="../processing/algorithms/trueortho.py" line="159" />
             <source>JPEG (lossy, 8-bit RGB images only; alpha becomes a mask)</source>
             <translation>JPEG (verlustbehaftet, nur 8-Bit-RGB-Bilder; Alpha wird zur Maske)</translation>
         </message>

@@ -4,62 +4,67 @@
     <context>
         <name>TruOrtho</name>
         <message>
-            <location filename="../processing/algorithms/base.py" line="20" />
+            <location filename="../processing/algorithms/base.py" line="21" />
             <source>Orientation</source>
             <translation>Orientation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="20" />
+            <location filename="../processing/algorithms/base.py" line="21" />
             <source>Orthophoto</source>
             <translation>Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="20" />
+            <location filename="../processing/algorithms/base.py" line="21" />
             <source>Surface</source>
             <translation>Surface</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="20" />
+            <location filename="../processing/algorithms/base.py" line="21" />
             <source>Tools</source>
             <translation>Outils</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="161" />
+            <location filename="../processing/algorithms/base.py" line="158" />
+            <source>Restore the colour edges of JPEGs with half-resolution colour</source>
+            <translation>Restaurer les contours de couleur des JPEG à couleur sous-échantillonnée</translation>
+        </message>
+        <message>
+            <location filename="../processing/algorithms/base.py" line="173" />
             <source>Run tiles on</source>
             <translation>Exécuter les tuiles sur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="174" />
+            <location filename="../processing/algorithms/base.py" line="186" />
             <source>Dask scheduler address (tls://host:port or scheduler file; empty = TRUORTHO_DASK_SCHEDULER)</source>
             <translation>Adresse du planificateur Dask (tls://hôte:port ou fichier de planificateur ; vide = TRUORTHO_DASK_SCHEDULER)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="194" />
+            <location filename="../processing/algorithms/base.py" line="206" />
             <source>Ground control points</source>
             <translation>Points d'appui</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="200" />
+            <location filename="../processing/algorithms/base.py" line="212" />
             <source>GCP image measurements (table)</source>
             <translation>Mesures image des points d'appui (table)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="119" />
+            <location filename="../processing/algorithms/base.py" line="120" />
             <source>TruOrtho algorithms could not be loaded: {}</source>
             <translation>Les algorithmes TruOrtho n'ont pas pu être chargés : {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="163" />
+            <location filename="../processing/algorithms/base.py" line="175" />
             <source>inprocess: this process (all cores)</source>
             <translation>inprocess : ce processus (tous les cœurs)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="164" />
+            <location filename="../processing/algorithms/base.py" line="176" />
             <source>local: a Dask cluster of worker processes on this computer</source>
             <translation>local : une grappe Dask de processus de travail sur cet ordinateur</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/base.py" line="165" />
+            <location filename="../processing/algorithms/base.py" line="177" />
             <source>scheduler: a Dask scheduler (SCHEDULER_ADDRESS)</source>
             <translation>scheduler : un planificateur Dask (SCHEDULER_ADDRESS)</translation>
         </message>
@@ -824,22 +829,22 @@
             <translation>Des photos à l'orthophoto vraie (chaîne complète)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="104" />
+            <location filename="../processing/algorithms/pipeline.py" line="97" />
             <source>DSM (filtered)</source>
             <translation>MNS (filtré)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="107" />
+            <location filename="../processing/algorithms/pipeline.py" line="100" />
             <source>True orthophoto</source>
             <translation>Orthophoto vraie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="108" />
+            <location filename="../processing/algorithms/pipeline.py" line="101" />
             <source>Occlusion mask</source>
             <translation>Masque d'occultation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="109" />
+            <location filename="../processing/algorithms/pipeline.py" line="102" />
             <source>Seamlines</source>
             <translation>Lignes de raccord</translation>
         </message>
@@ -854,52 +859,47 @@
             <translation>Réutiliser un orientation.json existant dans le dossier de sortie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="94" />
-            <source>Restore the colour edges of JPEGs with half-resolution colour</source>
-            <translation>Restaurer les contours de couleur des JPEG à couleur sous-échantillonnée</translation>
-        </message>
-        <message>
-            <location filename="../processing/algorithms/pipeline.py" line="124" />
+            <location filename="../processing/algorithms/pipeline.py" line="117" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES : indiquez le dossier des photos</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="140" />
+            <location filename="../processing/algorithms/pipeline.py" line="133" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER : indiquez un dossier pour les produits</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="150" />
+            <location filename="../processing/algorithms/pipeline.py" line="143" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION : nombre positif de mètres ou 0 attendu</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="189" />
+            <location filename="../processing/algorithms/pipeline.py" line="182" />
             <source>DSM (TruOrtho)</source>
             <translation>MNS (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="190" />
+            <location filename="../processing/algorithms/pipeline.py" line="183" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>Orthophoto vraie (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="191" />
+            <location filename="../processing/algorithms/pipeline.py" line="184" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Occultation (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="192" />
+            <location filename="../processing/algorithms/pipeline.py" line="185" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Lignes de raccord (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="173" />
+            <location filename="../processing/algorithms/pipeline.py" line="166" />
             <source>Tiles ran on: {}</source>
             <translation>Tuiles calculées sur : {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="172" />
+            <location filename="../processing/algorithms/pipeline.py" line="165" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{} : {:.1f} s, pic {:.0f} Mo ; {}</translation>
         </message>
@@ -1004,37 +1004,37 @@
             <translation>Supprimer le vignettage (avec la correction colorimétrique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="130" />
+            <location filename="../processing/algorithms/trueortho.py" line="123" />
             <source>Maximum off-nadir viewing angle (degrees)</source>
             <translation>Angle de visée maximal par rapport au nadir (degrés)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="140" />
+            <location filename="../processing/algorithms/trueortho.py" line="133" />
             <source>Blend width across seamlines (cells)</source>
             <translation>Largeur du fondu aux lignes de raccord (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="161" />
+            <location filename="../processing/algorithms/trueortho.py" line="154" />
             <source>Compression of the orthophoto</source>
             <translation>Compression de l'orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="174" />
+            <location filename="../processing/algorithms/trueortho.py" line="167" />
             <source>JPEG quality</source>
             <translation>Qualité JPEG</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="186" />
+            <location filename="../processing/algorithms/trueortho.py" line="179" />
             <source>Source image index</source>
             <translation>Index de l'image source</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="197" />
+            <location filename="../processing/algorithms/trueortho.py" line="190" />
             <source>Seamlines (source image regions)</source>
             <translation>Lignes de raccord (zones des images sources)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="212" />
+            <location filename="../processing/algorithms/trueortho.py" line="205" />
             <source>SURFACE: give a DSM raster or a mesh file</source>
             <translation>SURFACE : indiquez un raster MNS ou un fichier de maillage</translation>
         </message>
@@ -1044,27 +1044,27 @@
             <translation>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;Tous les fichiers (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="247" />
+            <location filename="../processing/algorithms/trueortho.py" line="240" />
             <source>{} x {} cells, {} images used, coverage {:.2%}, {} cells seen by no image</source>
             <translation>{} x {} cellules, {} images utilisées, couverture {:.2%}, {} cellules vues par aucune image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="163" />
+            <location filename="../processing/algorithms/trueortho.py" line="156" />
             <source>DEFLATE (lossless, read by every GIS)</source>
             <translation>DEFLATE (sans perte, lu par tous les SIG)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="164" />
+            <location filename="../processing/algorithms/trueortho.py" line="157" />
             <source>ZSTD (lossless, fastest to write, larger)</source>
             <translation>ZSTD (sans perte, écriture la plus rapide, plus volumineux)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="165" />
+            <location filename="../processing/algorithms/trueortho.py" line="158" />
             <source>LZW (lossless)</source>
             <translation>LZW (sans perte)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="166" />
+            <location filename="../processing/algorithms/trueortho.py" line="159" />
             <source>JPEG (lossy, 8-bit RGB images only; alpha becomes a mask)</source>
             <translation>JPEG (avec perte, images RVB 8 bits seulement ; l'alpha devient un masque)</translation>
         </message>

@@ -9,6 +9,7 @@ from typing import Any
 from qgis.core import (
     QgsProcessing,
     QgsProcessingAlgorithm,
+    QgsProcessingParameterBoolean,
     QgsProcessingParameterEnum,
     QgsProcessingParameterString,
     QgsProcessingParameterVectorLayer,
@@ -148,6 +149,17 @@ class TruOrthoAlgorithm(QgsProcessingAlgorithm):
         return param
 
     EXECUTOR_CHOICES = EXECUTOR_CHOICES
+
+    def add_restore_chroma(self) -> None:
+        """The advanced RESTORE_CHROMA parameter of the algorithms that make a true orthophoto."""
+        self.add(
+            QgsProcessingParameterBoolean(
+                "RESTORE_CHROMA",
+                tr("Restore the colour edges of JPEGs with half-resolution colour"),
+                self.default("RESTORE_CHROMA"),
+            ),
+            advanced=True,
+        )
 
     def add_executor(self) -> None:
         """The advanced EXECUTOR and SCHEDULER_ADDRESS parameters of the tiled algorithms."""

@@ -88,14 +88,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
                 self.default(self.REUSE_ORIENTATION),
             )
         )
-        self.add(
-            QgsProcessingParameterBoolean(
-                self.RESTORE_CHROMA,
-                tr("Restore the colour edges of JPEGs with half-resolution colour"),
-                self.default(self.RESTORE_CHROMA),
-            ),
-            advanced=True,
-        )
+        self.add_restore_chroma()
         self.add_executor()
         self.add(QgsProcessingParameterFolderDestination(self.OUTPUT_FOLDER, tr("Output folder")))
         names = {

@@ -116,14 +116,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 self.default(self.VIGNETTING),
             )
         )
-        self.add(
-            QgsProcessingParameterBoolean(
-                self.RESTORE_CHROMA,
-                tr("Restore the colour edges of JPEGs with half-resolution colour"),
-                self.default(self.RESTORE_CHROMA),
-            ),
-            advanced=True,
-        )
+        self.add_restore_chroma()
         self.add(
             QgsProcessingParameterNumber(
                 self.MAX_VIEW_ANGLE,
