@@ -97,11 +97,12 @@ class LevelPlan:
         The coarser levels also keep near-ties (no uniqueness test): their heights only set the
         bands of the next level, and a near-tie's height guides better than a hole, whose band
         falls back to a 7 x 7 neighbourhood or the tile's range. On the acceptance battery
-        (uniqueness 0.99 on level 0 only) edge cells within 3 GSD rose on 7 of 12 scenes by up
-        to 0.7 points (scene 2: 79.7 -> 80.4 %) and fell on the other 5 by at most 0.2, flat3 and
-        NMAD were unchanged; on boruszyn the holes of OSGM's DSM fell by 1 % (holes of 1 m^2 or more 143 ->
-        130) with the same roughness. Switching the test off on level 0 as well kept 6,092 more
-        cells over the battery, 43 % of them more than 3 GSD off: there the test stays.
+        (``bench/osgm_battery.py``; uniqueness 0.99 on level 0 only) edge cells within 3 GSD rose
+        on 7 of 12 scenes by up to 0.7 points (scene 2: 79.7 -> 80.4 %) and fell on the other 5 by
+        at most 0.2, flat3 and NMAD were unchanged; on boruszyn the holes of OSGM's DSM fell by 1 %
+        (holes of 1 m^2 or more 143 -> 130) with the same roughness. Switching the test off on
+        level 0 as well kept 6,092 more cells over the battery, 43 % of them more than 3 GSD off:
+        there the test stays.
         """
         if lv == 0:
             return params

@@ -331,8 +331,9 @@ SEAM_TOLERANCE = 2.0
 #: ``max(16, tile_size / 8)`` cells, the run-up SGM's paths need where a cell may search the whole
 #: height range. On the finest level every cell searches a narrow band around level 1's result, so
 #: the paths need less: 16 instead of 32 cells (tile size 256) made OSGM 12 % faster on the
-#: acceptance battery (scenes 1-11, 122 -> 108 s) with the mean figures unchanged or better (NMAD
-#: 0.247 -> 0.243 GSD, edge3 0.855 -> 0.856; per scene edge3 -0.9 to +1.8 points), and 31 %
+#: acceptance battery (``bench/osgm_battery.py``, scenes 1-11, 122 -> 108 s) with the mean
+#: figures unchanged or better (NMAD 0.247 -> 0.243 GSD, edge3 0.855 -> 0.856; per scene edge3
+#: -0.9 to +1.8 points), and 31 %
 #: faster on boruszyn (28 real photos at 0.25 m, 176 -> 121 s) with the same holes (45,600 cells
 #: against 45,500). About 30 % of the finest level's work had been the tiles' overlap.
 FINE_OVERLAP = 16
@@ -340,6 +341,8 @@ FINE_OVERLAP = 16
 
 def level_overlap(tile_size: int, lv: int) -> int:
     """Cells of overlap of the tiles of pyramid level ``lv`` (0: the finest) for ``tile_size``."""
+    if int(tile_size) < 1 or int(lv) < 0:
+        raise InputError(f"level_overlap: expected tile_size >= 1 and lv >= 0, got {tile_size!r}, {lv!r}")
     coarse = max(16, int(tile_size) // 8)
     return coarse if lv > 0 else min(coarse, FINE_OVERLAP)
 

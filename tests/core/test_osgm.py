@@ -110,6 +110,10 @@ def test_the_finest_level_tiles_overlap_less():
         assert level_overlap(ts, 0) == min(FINE_OVERLAP, max(16, ts // 8))
         assert all(level_overlap(ts, lv) == max(16, ts // 8) for lv in (1, 2, 5))
     assert level_overlap(256, 0) < level_overlap(256, 1)
+    with pytest.raises(InputError, match="level_overlap"):
+        level_overlap(0, 0)
+    with pytest.raises(InputError, match="level_overlap"):
+        level_overlap(256, -1)
 
 
 def test_coarse_levels_keep_near_ties():

@@ -1,0 +1,102 @@
+"""OSGM alone on the acceptance battery's scenes: DSM figures and time per scene, no ortho, no SGBM.
+
+Not a test. The quick loop for changes to dense matching (about 2 minutes for the 12 scenes here,
+against 5 for the whole battery). The scenes are drawn as ``bench/acceptance.py`` draws them and
+rendered once into ``--keep DIR`` (with the truth masks the figures need); later runs reuse them::
+
+    source scripts/env.sh && python -P bench/osgm_battery.py --keep DIR [--tag NAME] [--only 0,2]
+        [--z-step-factor 1.5] [--uniqueness 0.99]
+
+Prints, per scene, the OSGM wall time and the figures of ``acceptance.dsm_figures`` (completeness,
+NMAD in GSD, flat3, edge3), writes them to ``DIR/<tag>.json`` and each DSM to
+``DIR/scene_NN/osgm_<tag>.tif``, so that two variants of the code can be compared cell by cell.
+The figures cited in ``core/osgm/levels.py`` and ``core/osgm/pipeline.py`` were measured with this
+loop (scenes 1-11 for times: the first scene also loads the compiled kernels).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import pickle
+import sys
+import time
+
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _scene(i: int, seed: int, folder: str) -> dict:
+    """The cached scene ``i`` (rendered and pickled on first use)."""
+    from acceptance import draw_config, dsm_masks
+
+    from truortho.core.rasterio_io import read_raster
+
+    path = os.path.join(folder, "scene.pkl")
+    if not os.path.exists(path):
+        from truortho.core.ortho import evaluate as ev
+        from truortho.core.synthetic import make_scene
+
+        cfg = draw_config(i, seed)
+        scene = make_scene(cfg)
+        scene.write(folder)
+        truth, grid, _ = read_raster(os.path.join(folder, "dsm.tif"))
+        d = {
+            "o": scene.orientation, "res": grid.res, "ext": scene.extent_world(), "gsd": cfg.gsd,
+            "zlo": float(np.nanmin(truth)) - 5.0, "zhi": float(np.nanmax(truth)) + 5.0,
+            "nvis": ev.truth_view_counts(scene, grid, tol=0.05), "edge": dsm_masks(truth, cfg.gsd, grid.res),
+        }  # fmt: skip
+        with open(path, "wb") as fh:
+            pickle.dump(d, fh)
+    with open(path, "rb") as fh:
+        return pickle.load(fh)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--keep", required=True, help="folder of the cached scenes and the results")
+    ap.add_argument("--tag", default="run", help="name of this variant's outputs")
+    ap.add_argument("--only", default="", help="comma-separated scene indices (default 0-11)")
+    ap.add_argument("--seed", type=int, default=2026)
+    ap.add_argument("--z-step-factor", type=float, default=0.0,
+                    help="Z_STEP as a multiple of the cell (0: the default)")  # fmt: skip
+    ap.add_argument("--uniqueness", type=float, default=None, help="OsgmConfig.uniqueness (default its own)")
+    args = ap.parse_args(argv)
+    sys.path.insert(0, HERE)
+    from acceptance import dsm_figures
+
+    from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
+    from truortho.core.rasterio_io import read_raster
+
+    indices = [int(v) for v in args.only.split(",") if v] or list(range(12))
+    extra = {} if args.uniqueness is None else {"uniqueness": args.uniqueness}
+    results = {}
+    for i in indices:
+        folder = os.path.join(args.keep, f"scene_{i:02d}")
+        d = _scene(i, args.seed, folder)
+        truth, _, _ = read_raster(os.path.join(folder, "dsm.tif"))
+        out = OsgmOutputs(dsm=os.path.join(folder, f"osgm_{args.tag}.tif"),
+                          confidence=os.path.join(folder, f"conf_{args.tag}.tif"))  # fmt: skip
+        cfg = OsgmConfig(resolution=d["res"], z_min=d["zlo"], z_max=d["zhi"],
+                         z_step=(args.z_step_factor * d["res"]) or None, **extra)  # fmt: skip
+        t = time.perf_counter()
+        run_osgm(d["o"], cfg, d["ext"], out, folder)
+        seconds = time.perf_counter() - t
+        dsm, _, _ = read_raster(out.dsm)
+        f = dict(dsm_figures(dsm, truth, d["nvis"] >= 2, d["edge"], d["gsd"]), seconds=seconds)
+        results[str(i)] = f
+        print(f"{args.tag} scene {i}: {seconds:6.1f} s, completeness {f['completeness']:.4f}, "
+              f"nmad {f['nmad_gsd']:.3f} GSD, flat3 {f['flat3']:.4f}, edge3 {f['edge3']:.4f}",
+              flush=True)  # fmt: skip
+    with open(os.path.join(args.keep, f"{args.tag}.json"), "w") as fh:
+        json.dump(results, fh, indent=1)
+    later = [f["seconds"] for k, f in results.items() if k != str(indices[0])]
+    print(f"{args.tag}: {sum(f['seconds'] for f in results.values()):.1f} s in all, "
+          f"{sum(later):.1f} s without the first scene")  # fmt: skip
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
