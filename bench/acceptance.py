@@ -32,7 +32,10 @@ Per scene, against the exact truth on the truth DSM's grid (the scene extent at 
   ghosting, median shift, coverage and mean dE (``core/ortho/evaluate.py``), and the share of
   cells seen by no image (truth, eroded by one cell) that carry a colour ("wrong fill"), and (not a
   goal) the wrong colours 1-6 cells from the outlines (``ghosting_beyond_outline``: leaning or
-  double-mapped buildings, without the outline's own placement that ``ghosting`` also counts).
+  double-mapped buildings, without the outline's own placement that ``ghosting`` also counts);
+* a calibration of the ghosting goal (not a goal): the truth DSM with every outline one cell off
+  (``truth_shift1``, moved one cell east), its DSM figures, and the ghosting of the true ortho on
+  it (``ortho_shift1``).
 
 Also, not goals: the mean dE after the best global per-channel gain and offset to the truth
 (``relative_dE``: the block's absolute exposure is not observable, see :func:`relative_delta_e`), and
@@ -267,7 +270,7 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     from truortho.core.ortho import evaluate as ev
     from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho
     from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
-    from truortho.core.rasterio_io import read_raster
+    from truortho.core.rasterio_io import read_raster, write_raster
     from truortho.core.surface.filter import filter_dsm
     from truortho.core.surface.quality import streak_index
     from truortho.core.synthetic import make_scene
@@ -367,6 +370,18 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
         row[key] = ortho_figures(path, truth_rgb, buildings, seen_ortho, unseen_core, gsd, res)
         row[key]["seconds"] = time.perf_counter() - t
         log(f"  {key}: {_fmt(row[key])}")
+    # what the ghosting goal asks of a DSM: the truth DSM with every outline one cell off (moved one
+    # cell east; a DSM well inside the DSM goals), through the same true ortho
+    shifted = truth.copy()
+    shifted[:, 1:] = truth[:, :-1]
+    write_raster(os.path.join(folder, "dsm_shift1.tif"), shifted.astype(np.float32), grid, nodata=-9999.0)
+    row["truth_shift1"] = dsm_figures(shifted, truth, seen2, edge, gsd)
+    path = os.path.join(folder, "ortho_shift1.tif")
+    ocfg = TrueOrthoConfig(resolution=res, extent=scene.extent_world())
+    true_ortho(scene.orientation, os.path.join(folder, "dsm_shift1.tif"), path, None, None, config=ocfg,
+               image_root=folder)  # fmt: skip
+    row["ortho_shift1"] = ortho_figures(path, truth_rgb, buildings, seen_ortho, unseen_core, gsd, res)
+    log(f"  truth DSM one cell off: {_fmt(row['truth_shift1'])}; ortho: {_fmt(row['ortho_shift1'])}")
     pictures(folder, os.path.join(HERE, "results", "acceptance", f"scene_{index:02d}.jpg"))
     conv = row["ortho_conventional"]["ghosting"]
     row["ortho_truth"]["ghosting_vs_conventional"] = row["ortho_truth"]["ghosting"] / conv if conv else 0.0
@@ -483,6 +498,9 @@ def summary(rows: list[dict]) -> list[str]:
         "ortho_osgm.relative_dE",
         "ortho_osgm.wrong_fill",
         "ortho_conventional.ghosting",
+        "truth_shift1.edge3",
+        "truth_shift1.flat3",
+        "ortho_shift1.ghosting",
         "osgm.streak_index",
         "truth_streak_index",
     )
