@@ -9,7 +9,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source scripts/env.sh &&
 
-.PHONY: setup test lint pytest demo bench acceptance acceptance-ablation acceptance-real zip docs
+.PHONY: setup test lint pytest demo bench acceptance acceptance-ablation acceptance-real acceptance-fountain zip docs
 
 setup:
 	bash scripts/setup.sh
@@ -56,6 +56,11 @@ acceptance-ablation: setup
 # Real photo blocks through the whole pipeline (no truth DSM): make acceptance-real REAL_ARGS="--blocks sample,brighton"
 acceptance-real: setup
 	$(ENV) $(PY) -P bench/real_blocks.py $(REAL_ARGS)
+
+# fountain-P11 (close range, ground-truth cameras) through truortho:osgm with OBLIQUE=auto (about 2 minutes):
+# make acceptance-fountain FOUNTAIN_ARGS="--write-docs"
+acceptance-fountain: setup
+	$(ENV) $(PY) -P bench/fountain.py $(FOUNTAIN_ARGS)
 
 # docs/algorithms.md from the algorithms and their help (tests/qgis/test_docs.py checks it is fresh).
 docs: setup
