@@ -722,7 +722,27 @@ def _match_surface(
                 cache_base,
             )  # fmt: skip
         )
+    if clouds:
+        clouds = _visible_clouds(o, systems, clouds, dsm, conf, local)
     return _Surface(dsm, conf, nadir.rgb, clouds, systems, len(plan.levels), nadir.tiles, nadir.max_volume)
+
+
+def _visible_clouds(o, systems, clouds, dsm, conf, local: RasterGrid) -> list:
+    """The oblique systems' points without those that confident surfaces hide from their own photos
+    (:mod:`.fusion`); the nadir DSM's confident cells are occluders too."""
+    from .fusion import CONFIDENT, visible_points
+
+    off = o.offset
+    X, Y = local.centres()
+    sure = np.isfinite(dsm) & (np.nan_to_num(conf) >= CONFIDENT)
+    occ = np.column_stack([X[sure], Y[sure], dsm[sure].astype(np.float64) - off[2]])
+    cams = [(im.R, im.C, o.camera_of(im)) for im in o.images]
+    images = [s.images for s in systems[1:]]
+    keep = visible_points([c[0] - off for c in clouds], [c[2] for c in clouds], images, cams, local.res, occ)
+    out = []
+    for (w, rgb, cf), k in zip(clouds, keep, strict=True):
+        out.append((w[k], None if rgb is None else rgb[k], cf[k]))
+    return out
 
 
 def _system_stats(systems, nadir_points: int, oblique_points: list[int], n_images: int) -> list[dict]:
