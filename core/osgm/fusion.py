@@ -49,33 +49,40 @@ def _depths(P, R, C):
 
 
 @njit
+def _pixel(uv, i, scale, h, w):
+    """Buffer pixel ``(row, col)`` of point ``i`` (``uv`` pixels, NaN = not framed); ``(-1, -1)``
+    where it is not framed."""
+    u = uv[i, 0]
+    v = uv[i, 1]
+    if not (u == u and v == v):
+        return -1, -1
+    iu = int((u + 0.5) * scale)
+    iv = int((v + 0.5) * scale)
+    if 0 <= iu < w and 0 <= iv < h:
+        return iv, iu
+    return -1, -1
+
+
+@njit
 def _splat(uv, depth, scale, zbuf):
-    """Nearest depth per buffer pixel (``uv`` pixels, NaN = not framed)."""
+    """Nearest depth per buffer pixel."""
     h, w = zbuf.shape
     for i in range(uv.shape[0]):
-        u = uv[i, 0]
-        v = uv[i, 1]
-        if not (u == u and v == v):
-            continue
-        iu = int((u + 0.5) * scale)
-        iv = int((v + 0.5) * scale)
-        if 0 <= iu < w and 0 <= iv < h and depth[i] < zbuf[iv, iu]:
-            zbuf[iv, iu] = depth[i]
+        r, c = _pixel(uv, i, scale, h, w)
+        if r >= 0 and depth[i] < zbuf[r, c]:
+            zbuf[r, c] = depth[i]
 
 
 @njit
 def _count(uv, depth, scale, zbuf, margin, framed, seen):
+    """Per point: one more photo that frames it, and one more that sees it (no buffer depth more
+    than ``margin`` nearer)."""
     h, w = zbuf.shape
     for i in range(uv.shape[0]):
-        u = uv[i, 0]
-        v = uv[i, 1]
-        if not (u == u and v == v):
-            continue
-        iu = int((u + 0.5) * scale)
-        iv = int((v + 0.5) * scale)
-        if 0 <= iu < w and 0 <= iv < h:
+        r, c = _pixel(uv, i, scale, h, w)
+        if r >= 0:
             framed[i] += 1
-            if not (zbuf[iv, iu] < depth[i] - margin):
+            if not (zbuf[r, c] < depth[i] - margin):
                 seen[i] += 1
 
 
