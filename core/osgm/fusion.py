@@ -7,11 +7,15 @@ behind the visible surface: on fountain-P11 (``bench/fountain.py``) a quarter of
 more than 0.3 m behind the wall. Such a point cannot have been seen: between it and its photos
 stands a surface that the block reconstructs with confidence. The check (:func:`visible_points`):
 
-1. **Occluders**: the points of every system (the nadir DSM's cells included) whose confidence is
-   at least :data:`CONFIDENT`, the level the DSM filter trusts a cell at.
+1. **Occluders**: the points of every oblique system whose confidence is at least
+   :data:`CONFIDENT`, the level the DSM filter trusts a cell at, and the nadir DSM's cells of that
+   confidence drawn as cell columns with their walls (:func:`~truortho.core.ortho.zbuffer.dsm_triangles`,
+   steps over :data:`MARGIN_CELLS` cells): a 2.5-D grid has no points on its walls, and drawn as
+   points it would let the rays through them.
 2. **Depth buffers**: for every photo of an oblique system, the occluders' depths along its optical
    axis, the nearest per buffer pixel; a pixel spans :data:`PIXEL_SPACINGS` times the median
-   spacing of the occluders in that photo, so that a surface leaves few empty pixels.
+   spacing of the occluders in that photo, so that a surface leaves few empty pixels. The DSM's
+   columns are rasterised into the same buffer (:func:`~truortho.core.ortho.zbuffer.render_depth`).
 3. **Visibility**: a point is hidden in a photo that frames it when the buffer there holds a depth
    more than :data:`MARGIN_CELLS` cells nearer than the point's own. A point is kept when at least
    :data:`MIN_VIEWS` photos of its own system frame it and do not hide it (matching needs a pair),
@@ -94,7 +98,7 @@ def _project(P, view):
 
 
 def visible_points(
-    points, confidence, system_images, cameras, res: float, occluders=None
+    points, confidence, system_images, cameras, res: float, occluders=None, surface=None
 ) -> list[np.ndarray]:
     """Which points of every system its own photos can see (module docstring).
 
@@ -107,7 +111,11 @@ def visible_points(
     res : float
         Cell size of the grids (m): the depth margin is :data:`MARGIN_CELLS` cells.
     occluders : (M, 3) array, optional
-        More confident surface points (the nadir DSM's cells), local frame.
+        More confident surface points, local frame.
+    surface : :class:`~truortho.core.ortho.zbuffer.Triangles`, optional
+        A confident surface drawn into the buffers as triangles (the nadir DSM's confident cells
+        with their walls, :func:`~truortho.core.ortho.zbuffer.dsm_triangles`): points cannot hide
+        what lies behind a wall, since a 2.5-D grid has no points on its walls.
 
     Returns
     -------
@@ -136,10 +144,19 @@ def visible_points(
         d = _depths(occ, np.asarray(R, np.float64), np.asarray(C, np.float64))
         ok = np.isfinite(uv[:, 0]) & (d > 0)
         # buffer pixel: PIXEL_SPACINGS median occluder spacings (f res / depth pixels)
+        if surface is not None and not ok.any():
+            sv = np.ascontiguousarray(surface.vertices)
+            d = _depths(sv, np.asarray(R, np.float64), np.asarray(C, np.float64))
+            ok = (d > 0) & np.isfinite(_project(sv, view)[:, 0])
         spacing = float(np.median(cam.fx * res / d[ok])) if ok.any() else 1.0
         scale = 1.0 / max(PIXEL_SPACINGS * spacing, 1.0)
         zbuf = np.full((int(cam.height * scale) + 1, int(cam.width * scale) + 1), np.inf)
-        _splat(uv, d, scale, zbuf)
+        _splat(uv, _depths(occ, np.asarray(R, np.float64), np.asarray(C, np.float64)), scale, zbuf)
+        if surface is not None and len(surface):
+            from ..ortho.zbuffer import render_depth
+
+            drawn = render_depth(surface, R, C, cam, (0, 0, zbuf.shape[1], zbuf.shape[0]), scale, cull=False)
+            np.minimum(zbuf, drawn, out=zbuf)
         for k, imgs in enumerate(system_images):
             if i not in imgs or not len(pts[k]):
                 continue

@@ -729,16 +729,18 @@ def _match_surface(
 
 def _visible_clouds(o, systems, clouds, dsm, conf, local: RasterGrid) -> list:
     """The oblique systems' points without those that confident surfaces hide from their own photos
-    (:mod:`.fusion`); the nadir DSM's confident cells are occluders too."""
-    from .fusion import CONFIDENT, visible_points
+    (:mod:`.fusion`); the nadir DSM's confident cells, with their walls, are occluders too."""
+    from ..ortho.zbuffer import dsm_triangles
+    from .fusion import CONFIDENT, MARGIN_CELLS, visible_points
 
     off = o.offset
-    X, Y = local.centres()
     sure = np.isfinite(dsm) & (np.nan_to_num(conf) >= CONFIDENT)
-    occ = np.column_stack([X[sure], Y[sure], dsm[sure].astype(np.float64) - off[2]])
+    heights = np.where(sure, dsm.astype(np.float64) - off[2], np.nan)
+    surface = dsm_triangles(heights, local.x_min, local.y_max, local.res, wall_min=MARGIN_CELLS * local.res)
     cams = [(im.R, im.C, o.camera_of(im)) for im in o.images]
     images = [s.images for s in systems[1:]]
-    keep = visible_points([c[0] - off for c in clouds], [c[2] for c in clouds], images, cams, local.res, occ)
+    keep = visible_points([c[0] - off for c in clouds], [c[2] for c in clouds], images, cams, local.res,
+                          surface=surface)  # fmt: skip
     out = []
     for (w, rgb, cf), k in zip(clouds, keep, strict=True):
         out.append((w[k], None if rgb is None else rgb[k], cf[k]))

@@ -78,3 +78,23 @@ def test_bad_input():
         visible_points([np.zeros((2, 3))], [np.zeros(3)], [[0]], _cameras(), RES)
     with pytest.raises(InputError, match="one confidence"):
         visible_points([np.zeros((2, 3))], [], [[0]], _cameras(), RES)
+
+
+def test_a_dsm_hides_behind_its_walls():
+    """A 2.5-D grid has no points on its walls: drawn as cell columns (dsm_triangles) it is opaque,
+    as points its walls let the rays through."""
+    from truortho.core.ortho.zbuffer import dsm_triangles
+
+    # a DSM 8 m deep from y = 8 to 16, ground at 0 with a 4 m high block from y = 9.5 to 10.5
+    x0, y_max = -6.0, 16.0
+    rows, cols = int(8.0 / RES), int(12.0 / RES)
+    y = y_max - (np.arange(rows) + 0.5) * RES
+    h = np.zeros((rows, cols))
+    h[(y > 9.5) & (y < 10.5), :] = 4.0
+    behind = _plane(12.0, -1.0, 1.0, 0.5, 2.0, 0.1)  # on the far side of the block, below its top
+    conf = np.full(len(behind), 0.1)
+    tris = dsm_triangles(h, x0, y_max, RES)
+    assert not visible_points([behind], [conf], [[0, 1, 2]], _cameras(), RES, surface=tris)[0].any()
+    X, Y = np.meshgrid(x0 + (np.arange(cols) + 0.5) * RES, y)
+    cells = np.column_stack([X.ravel(), Y.ravel(), h.ravel()])
+    assert visible_points([behind], [conf], [[0, 1, 2]], _cameras(), RES, occluders=cells)[0].all()
