@@ -43,17 +43,14 @@ import argparse
 import json
 import math
 import os
-import subprocess
 import sys
 import tempfile
-import time
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 DATA = os.path.join(os.path.dirname(ROOT), "shared", "data", "fountain-P11")
-QP = os.path.join(ROOT, "scripts", "qgis_process")
 
 #: The stand-in CRS and the shift of the block into it (the block itself has none).
 CRS = "EPSG:32632"
@@ -243,21 +240,9 @@ def run_osgm(out: str, resolution: float) -> tuple[float, float]:
         f"DSM={out}/dsm.tif",
         f"POINT_CLOUD={out}/cloud.las",
     ]
-    log = os.path.join(out, "osgm.log")
-    t = time.perf_counter()
-    with open(log, "w") as fh:
-        p = subprocess.Popen([QP, "run", "truortho:osgm", "--", *args], stdout=fh, stderr=subprocess.STDOUT)
-        if hasattr(os, "wait4"):
-            _, status, usage = os.wait4(p.pid, 0)
-            p.returncode = os.waitstatus_to_exitcode(status)
-            peak = usage.ru_maxrss / 1024.0
-        else:  # pragma: no cover - Windows
-            p.wait()
-            peak = math.nan
-    seconds = time.perf_counter() - t
-    if p.returncode:
-        raise SystemExit(f"fountain: truortho:osgm failed (see {log}):\n{open(log).read()[-2000:]}")
-    return seconds, peak
+    from real_blocks import qgis_run
+
+    return qgis_run("truortho:osgm", args, os.path.join(out, "osgm.log"), "fountain")
 
 
 def main(argv=None) -> int:

@@ -65,14 +65,13 @@ BLOCKS = {
 }
 
 
-def qgis_pipeline(args: list[str], folder: str, label: str) -> tuple[float, float]:
-    """``truortho:pipeline`` through ``qgis_process`` with ``args``; its output goes to
-    ``folder/pipeline.log``. Returns the wall time (s) and the peak resident memory of the process
-    tree (MB; NaN where ``os.wait4`` is missing); a failure ends the bench."""
-    log = os.path.join(folder, "pipeline.log")
+def qgis_run(algorithm: str, args: list[str], log: str, label: str) -> tuple[float, float]:
+    """``algorithm`` through ``qgis_process`` with ``args``; its output goes to the file ``log``.
+    Returns the wall time (s) and the peak resident memory of the process tree (MB; NaN where
+    ``os.wait4`` is missing); a failure ends the bench."""
     t = time.perf_counter()
     with open(log, "w") as fh:
-        cmd = [QP, "run", "truortho:pipeline", "--", *args]
+        cmd = [QP, "run", algorithm, "--", *args]
         p = subprocess.Popen(cmd, stdout=fh, stderr=subprocess.STDOUT)
         if hasattr(os, "wait4"):
             _, status, usage = os.wait4(p.pid, 0)
@@ -85,8 +84,13 @@ def qgis_pipeline(args: list[str], folder: str, label: str) -> tuple[float, floa
     if p.returncode:
         with open(log) as fh:
             tail = fh.read()[-2000:]
-        raise SystemExit(f"{label}: the pipeline failed (see {log}):\n{tail}")
+        raise SystemExit(f"{label}: {algorithm} failed (see {log}):\n{tail}")
     return seconds, peak
+
+
+def qgis_pipeline(args: list[str], folder: str, label: str) -> tuple[float, float]:
+    """``truortho:pipeline`` through :func:`qgis_run`, its output in ``folder/pipeline.log``."""
+    return qgis_run("truortho:pipeline", args, os.path.join(folder, "pipeline.log"), label)
 
 
 def resolution_of(spec: str, block: str) -> float:

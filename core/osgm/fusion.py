@@ -28,8 +28,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import CancelledError, InputError
 from ..jit import njit
+from ..ortho.zbuffer import render_depth
+from ..progress import Progress, as_progress
 from ..surface.filter.config import DsmFilterConfig
 from .views import _project_many, monotonic_radius2
 
@@ -98,7 +100,8 @@ def _project(P, view):
 
 
 def visible_points(
-    points, confidence, system_images, cameras, res: float, occluders=None, surface=None
+    points, confidence, system_images, cameras, res: float, occluders=None, surface=None,
+    progress: Progress | None = None,
 ) -> list[np.ndarray]:
     """Which points of every system its own photos can see (module docstring).
 
@@ -116,6 +119,8 @@ def visible_points(
         A confident surface drawn into the buffers as triangles (the nadir DSM's confident cells
         with their walls, :func:`~truortho.core.ortho.zbuffer.dsm_triangles`): points cannot hide
         what lies behind a wall, since a 2.5-D grid has no points on its walls.
+    progress : Progress, optional
+        Reported per photo; a cancelled check raises :class:`~truortho.core.errors.CancelledError`.
 
     Returns
     -------
@@ -125,10 +130,18 @@ def visible_points(
         raise InputError(f"visible_points: res must be a number > 0, got {res!r}")
     if not (len(points) == len(confidence) == len(system_images)):
         raise InputError("visible_points: expected one confidence array and one image list per system")
-    pts = [np.ascontiguousarray(np.asarray(p, np.float64).reshape(-1, 3)) for p in points]
+    pts = [np.ascontiguousarray(np.asarray(p, np.float64)) for p in points]
     for p, c in zip(pts, confidence, strict=True):
+        if p.ndim != 2 or p.shape[1] != 3:
+            raise InputError(f"visible_points: points must have shape (N, 3), got {p.shape}")
         if np.shape(c) != (len(p),):
             raise InputError(f"visible_points: {len(p)} points but {np.shape(c)} confidences")
+    users = sorted({int(i) for imgs in system_images for i in imgs})
+    if users and (users[0] < 0 or users[-1] >= len(cameras)):
+        raise InputError(
+            f"visible_points: image indices must lie in 0 .. {len(cameras) - 1}, got {users[0]}..{users[-1]}"
+        )
+    progress = as_progress(progress)
     parts = [p[np.asarray(c) >= CONFIDENT] for p, c in zip(pts, confidence, strict=True)]
     if occluders is not None and len(occluders):
         parts.append(np.asarray(occluders, np.float64).reshape(-1, 3))
@@ -136,31 +149,31 @@ def visible_points(
     framed = [np.zeros(len(p), np.int64) for p in pts]
     seen = [np.zeros(len(p), np.int64) for p in pts]
     margin = MARGIN_CELLS * res
-    users = sorted({i for imgs in system_images for i in imgs})
-    for i in users:
-        R, C, cam = cameras[i]
+    for j, i in enumerate(users):
+        if progress.cancelled():
+            raise CancelledError("visibility check cancelled")
+        progress.update(j / len(users), "visibility check of the oblique points")
+        R0, C0, cam = cameras[i]
+        R, C = np.ascontiguousarray(R0, np.float64), np.ascontiguousarray(C0, np.float64)
         view = (R, C, cam, monotonic_radius2(cam))
         uv = _project(occ, view)
-        d = _depths(occ, np.asarray(R, np.float64), np.asarray(C, np.float64))
-        ok = np.isfinite(uv[:, 0]) & (d > 0)
+        d_occ = _depths(occ, R, C)
         # buffer pixel: PIXEL_SPACINGS median occluder spacings (f res / depth pixels)
+        d, ok = d_occ, np.isfinite(uv[:, 0]) & (d_occ > 0)
         if surface is not None and not ok.any():
             sv = np.ascontiguousarray(surface.vertices)
-            d = _depths(sv, np.asarray(R, np.float64), np.asarray(C, np.float64))
+            d = _depths(sv, R, C)
             ok = (d > 0) & np.isfinite(_project(sv, view)[:, 0])
         spacing = float(np.median(cam.fx * res / d[ok])) if ok.any() else 1.0
         scale = 1.0 / max(PIXEL_SPACINGS * spacing, 1.0)
         zbuf = np.full((int(cam.height * scale) + 1, int(cam.width * scale) + 1), np.inf)
-        _splat(uv, _depths(occ, np.asarray(R, np.float64), np.asarray(C, np.float64)), scale, zbuf)
+        _splat(uv, d_occ, scale, zbuf)
         if surface is not None and len(surface):
-            from ..ortho.zbuffer import render_depth
-
             drawn = render_depth(surface, R, C, cam, (0, 0, zbuf.shape[1], zbuf.shape[0]), scale, cull=False)
             np.minimum(zbuf, drawn, out=zbuf)
         for k, imgs in enumerate(system_images):
             if i not in imgs or not len(pts[k]):
                 continue
-            uvk = _project(pts[k], view)
-            dk = _depths(pts[k], np.asarray(R, np.float64), np.asarray(C, np.float64))
-            _count(uvk, dk, scale, zbuf, margin, framed[k], seen[k])
+            _count(_project(pts[k], view), _depths(pts[k], R, C), scale, zbuf, margin, framed[k], seen[k])
+    progress.update(1.0, "visibility check of the oblique points")
     return [(s >= MIN_VIEWS) | (f < MIN_VIEWS) for f, s in zip(framed, seen, strict=True)]

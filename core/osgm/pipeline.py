@@ -723,11 +723,11 @@ def _match_surface(
             )  # fmt: skip
         )
     if clouds:
-        clouds = _visible_clouds(o, systems, clouds, dsm, conf, local)
+        clouds = _visible_clouds(o, systems, clouds, dsm, conf, local, SubProgress(progress, 0.8, 0.85))
     return _Surface(dsm, conf, nadir.rgb, clouds, systems, len(plan.levels), nadir.tiles, nadir.max_volume)
 
 
-def _visible_clouds(o, systems, clouds, dsm, conf, local: RasterGrid) -> list:
+def _visible_clouds(o, systems, clouds, dsm, conf, local: RasterGrid, progress) -> list:
     """The oblique systems' points without those that confident surfaces hide from their own photos
     (:mod:`.fusion`); the nadir DSM's confident cells, with their walls, are occluders too."""
     from ..ortho.zbuffer import dsm_triangles
@@ -740,7 +740,7 @@ def _visible_clouds(o, systems, clouds, dsm, conf, local: RasterGrid) -> list:
     cams = [(im.R, im.C, o.camera_of(im)) for im in o.images]
     images = [s.images for s in systems[1:]]
     keep = visible_points([c[0] - off for c in clouds], [c[2] for c in clouds], images, cams, local.res,
-                          surface=surface)  # fmt: skip
+                          surface=surface, progress=progress)  # fmt: skip
     out = []
     for (w, rgb, cf), k in zip(clouds, keep, strict=True):
         out.append((w[k], None if rgb is None else rgb[k], cf[k]))

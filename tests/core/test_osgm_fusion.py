@@ -78,6 +78,24 @@ def test_bad_input():
         visible_points([np.zeros((2, 3))], [np.zeros(3)], [[0]], _cameras(), RES)
     with pytest.raises(InputError, match="one confidence"):
         visible_points([np.zeros((2, 3))], [], [[0]], _cameras(), RES)
+    with pytest.raises(InputError, match=r"shape \(N, 3\)"):
+        visible_points([np.zeros((4, 2))], [np.zeros(4)], [[0]], _cameras(), RES)
+    with pytest.raises(InputError, match="image indices"):
+        visible_points([np.zeros((2, 3))], [np.zeros(2)], [[0, 3]], _cameras(), RES)
+
+
+def test_cancel():
+    from truortho.core.errors import CancelledError
+    from truortho.core.progress import CallbackProgress
+
+    seen = []
+    pts = _plane(10.0, -1.0, 1.0, 1.0, 2.0, 0.1)
+    visible_points([pts], [np.full(len(pts), 0.1)], [[0, 1, 2]], _cameras(), RES,
+                   progress=CallbackProgress(lambda f, m=None: seen.append(f)))  # fmt: skip
+    assert seen[0] == 0.0 and seen[-1] == 1.0 and len(seen) == 4
+    with pytest.raises(CancelledError):
+        visible_points([pts], [np.full(len(pts), 0.1)], [[0, 1, 2]], _cameras(), RES,
+                       progress=CallbackProgress(is_cancelled=lambda: True))  # fmt: skip
 
 
 def test_a_dsm_hides_behind_its_walls():
