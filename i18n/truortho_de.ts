@@ -1520,346 +1520,346 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="282" />
-            <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
-            <translation>Berechnet ein True Orthophoto aus orientierten Bildern und einer Oberfläche (einem DOM-Raster wie dem von OSGM oder einem PLY/OBJ-Dreiecksnetz): jede Zelle wird aus einem Bild eingefärbt, das sie wirklich sieht, ermittelt mit einem Tiefenpuffer der Oberfläche je Bild (DOM-Zellen als flache Dächer mit senkrechten Wänden an Höhensprüngen, oder die Dreiecke des Netzes; Frustum- und Rückseiten-Culling). Unter den Bildern, die eine Zelle sehen, wird dasjenige mit der feinsten effektiven Bodenauflösung (Entfernung und Einfallswinkel auf der Oberfläche) bevorzugt; Dächer werden jeweils aus einem einzigen Bild texturiert, und die Nahtlinien folgen Höhensprüngen und meiden Stellen, an denen die Bilder nicht übereinstimmen (Label-Glättung), mit Überblendung über die Nähte nur zwischen Bildern, die beide die Zellen sehen. Farbkorrekturen je Bild in CIE L*a*b* (Verstärkung/Versatz je Kanal für Nicht-RGB-Daten) werden per Ausgleichung nach kleinsten Quadraten aus Zellen geschätzt, die mehrere Bilder sehen. Zellen, die kein Bild sieht, erhalten Alpha 0 und erscheinen in der Verdeckungsmaske. Kanalanzahl und Datentyp der Bilder bleiben erhalten (RGB, 16-Bit-panchromatisch, thermal). Die Verarbeitung läuft kachelweise mit begrenztem Speicher; Fortschritt und Abbruch je Kachel.</translation>
+            <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections (a gain/offset per RGB channel for white balance and exposure, then one in CIE L*a*b*; per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
+            <translation>Berechnet ein True Orthophoto aus orientierten Bildern und einer Oberfläche (einem DOM-Raster wie dem von OSGM oder einem PLY/OBJ-Dreiecksnetz): jede Zelle wird aus einem Bild eingefärbt, das sie wirklich sieht, ermittelt mit einem Tiefenpuffer der Oberfläche je Bild (DOM-Zellen als flache Dächer mit senkrechten Wänden an Höhensprüngen, oder die Dreiecke des Netzes; Frustum- und Rückseiten-Culling). Unter den Bildern, die eine Zelle sehen, wird dasjenige mit der feinsten effektiven Bodenauflösung (Entfernung und Einfallswinkel auf der Oberfläche) bevorzugt; Dächer werden jeweils aus einem einzigen Bild texturiert, und die Nahtlinien folgen Höhensprüngen und meiden Stellen, an denen die Bilder nicht übereinstimmen (Label-Glättung), mit Überblendung über die Nähte nur zwischen Bildern, die beide die Zellen sehen. Farbkorrekturen je Bild (Verstärkung/Versatz je RGB-Kanal für Weißabgleich und Belichtung, danach in CIE L*a*b*; Verstärkung/Versatz je Kanal für Nicht-RGB-Daten) werden per Ausgleichung nach kleinsten Quadraten aus Zellen geschätzt, die mehrere Bilder sehen. Zellen, die kein Bild sieht, erhalten Alpha 0 und erscheinen in der Verdeckungsmaske. Kanalanzahl und Datentyp der Bilder bleiben erhalten (RGB, 16-Bit-panchromatisch, thermal). Die Verarbeitung läuft kachelweise mit begrenztem Speicher; Fortschritt und Abbruch je Kachel.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="296" />
+            <location filename="../processing/help/__init__.py" line="297" />
             <source>Orientation JSON (from Orient images or Import orientation); its images must be on disk.</source>
             <translation>Orientierungs-JSON (aus Bilder orientieren oder Orientierung importieren); seine Bilder müssen auf der Festplatte vorhanden sein.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="298" />
+            <location filename="../processing/help/__init__.py" line="299" />
             <source>DSM GeoTIFF (any CRS; resampled onto the output grid by nearest neighbour) or a PLY/OBJ mesh. Heights must use the orientation's vertical datum. It must cover the extent.</source>
             <translation>DOM-GeoTIFF (beliebiges KBS; per nächstem Nachbarn auf das Ausgaberaster umgebildet) oder ein PLY/OBJ-Dreiecksnetz. Die Höhen müssen das Höhendatum der Orientierung verwenden. Es muss die Ausdehnung abdecken.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="300" />
+            <location filename="../processing/help/__init__.py" line="301" />
             <source>Output extent; default the surface's extent.</source>
             <translation>Ausgabeausdehnung; Standard ist die Ausdehnung der Oberfläche.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="301" />
+            <location filename="../processing/help/__init__.py" line="302" />
             <source>Output cell size in units of the output CRS; 0 = the DSM's cell size.</source>
             <translation>Ausgabezellgröße in Einheiten des Ausgabe-KBS; 0 = Zellgröße des DOM.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="302" />
+            <location filename="../processing/help/__init__.py" line="303" />
             <source>Output CRS; default the orientation's. When it differs, the computation runs on the output grid and cell centres are transformed to the orientation's CRS (images are resampled once).</source>
             <translation>Ausgabe-KBS; Standard ist das der Orientierung. Weicht es ab, läuft die Berechnung auf dem Ausgaberaster, und die Zellmittelpunkte werden in das KBS der Orientierung transformiert (die Bilder werden nur einmal umgebildet).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="305" />
+            <location filename="../processing/help/__init__.py" line="306" />
             <source>Estimate and apply per-image colour corrections before mosaicking.</source>
             <translation>Farbkorrekturen je Bild vor der Mosaikbildung schätzen und anwenden.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="306" />
+            <location filename="../processing/help/__init__.py" line="307" />
             <source>With the colour correction: estimate a radial darkening towards the image corners per camera from the overlaps and remove it first. Images without vignetting get a factor of about 1; switch it off for images already corrected in processing.</source>
             <translation>Mit der Farbkorrektur: je Kamera eine radiale Abdunklung zu den Bildecken aus den Überlappungen schätzen und zuerst entfernen. Bilder ohne Vignettierung erhalten einen Faktor von etwa 1; für bereits bei der Entwicklung korrigierte Bilder ausschalten.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="313" />
+            <location filename="../processing/help/__init__.py" line="314" />
             <source>Largest off-nadir angle of the viewing ray (degrees) for an image to texture a cell; also bounds how far outside a tile occluders are searched.</source>
             <translation>Größter Winkel des Sehstrahls zum Nadir (Grad), unter dem ein Bild eine Zelle texturieren darf; begrenzt auch, wie weit außerhalb einer Kachel nach verdeckenden Objekten gesucht wird.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="315" />
+            <location filename="../processing/help/__init__.py" line="316" />
             <source>Width of the feathering across seamlines, in cells (0 = hard seams).</source>
             <translation>Breite der Überblendung an den Nahtlinien, in Zellen (0 = harte Nähte).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="316" />
+            <location filename="../processing/help/__init__.py" line="317" />
             <source>Tile side in cells; memory grows with its square and the images per tile.</source>
             <translation>Kachelseite in Zellen; der Speicherbedarf wächst mit ihrem Quadrat und den Bildern pro Kachel.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="317" />
+            <location filename="../processing/help/__init__.py" line="318" />
             <source>Compression of the orthophoto. DEFLATE (the default), ZSTD and LZW are lossless: DEFLATE gives the smallest files and every GIS reads it; ZSTD (level 1) writes about twice as fast and about 9 % larger (GDAL 2.3 or later reads it); LZW is for older readers. JPEG is lossy (about a fifth of the size), for 8-bit RGB images only: RGB is stored as YCbCr with halved colour resolution, so colours blur across sharp edges such as building outlines (deliver and view with it; measure on a lossless one), and the alpha band becomes the file's internal mask. The source index and occlusion mask always stay lossless.</source>
             <translation>Kompression des Orthophotos. DEFLATE (Standard), ZSTD und LZW sind verlustfrei: DEFLATE ergibt die kleinsten Dateien und jedes GIS liest es; ZSTD (Stufe 1) schreibt etwa doppelt so schnell und etwa 9 % größer (lesbar ab GDAL 2.3); LZW ist für ältere Leseprogramme. JPEG ist verlustbehaftet (etwa ein Fünftel der Größe), nur für 8-Bit-RGB-Bilder: RGB wird als YCbCr mit halbierter Farbauflösung gespeichert, sodass Farben über scharfe Kanten wie Gebäudeumrisse verschwimmen (zum Ausliefern und Ansehen; gemessen wird an einer verlustfreien Datei), und das Alphaband wird zur internen Maske der Datei. Quellbildindex und Verdeckungsmaske bleiben immer verlustfrei.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="324" />
+            <location filename="../processing/help/__init__.py" line="325" />
             <source>JPEG quality (1-100) when COMPRESSION is JPEG.</source>
             <translation>JPEG-Qualität (1-100), wenn COMPRESSION JPEG ist.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="325" />
+            <location filename="../processing/help/__init__.py" line="326" />
             <source>Where the tiles of the mosaic are computed; the true orthophoto, source index, occlusion mask and seamlines are identical with every choice. inprocess: in QGIS's process, the independent tiles of a wave in parallel threads (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images and the surface at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The colour correction (on a decimated grid) is estimated in QGIS's process. Finished tiles are kept in a folder beside the output (its name plus '.tiles') until the run succeeds, so a rerun with the same inputs and parameters after a crash reuses them.</source>
             <translation>Wo die Kacheln des Mosaiks berechnet werden; True Orthophoto, Quellbildindex, Verdeckungsmaske und Nahtlinien sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, die unabhängigen Kacheln einer Welle parallel in Threads (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen die Bilder und die Oberfläche unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Der Farbausgleich (auf einem ausgedünnten Raster) wird im Prozess von QGIS geschätzt. Fertige Kacheln werden bis zum erfolgreichen Ende des Laufs in einem Ordner neben der Ausgabe aufbewahrt (ihr Name plus '.tiles'), sodass ein erneuter Lauf mit denselben Eingaben und Parametern nach einem Absturz sie wiederverwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="337" />
+            <location filename="../processing/help/__init__.py" line="338" />
             <source>GeoTIFF with the images' bands and data type plus an alpha band (an internal mask with JPEG compression), tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
             <translation>GeoTIFF mit den Bändern und dem Datentyp der Bilder plus einem Alphaband (bei JPEG-Kompression eine interne Maske), gekachelt, mit Übersichten, im Cloud-Optimized-GeoTIFF-Layout.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="339" />
+            <location filename="../processing/help/__init__.py" line="340" />
             <source>Int16 GeoTIFF: index (0-based, orientation order) of the image each cell comes from; -1 = nodata.</source>
             <translation>Int16-GeoTIFF: Index (ab 0, Reihenfolge der Orientierung) des Bildes, aus dem jede Zelle stammt; -1 = NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="341" />
+            <location filename="../processing/help/__init__.py" line="342" />
             <source>UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the surface has no data.</source>
             <translation>UInt8-GeoTIFF: 1, wo kein Bild die Zelle sieht, 0, wo sie gesehen wird, 255, wo die Oberfläche keine Daten hat.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="343" />
+            <location filename="../processing/help/__init__.py" line="344" />
             <source>Polygons, one feature per source image: the cells it colours (image_index, image, cells, area).</source>
             <translation>Polygone, ein Objekt pro Quellbild: die Zellen, die es einfärbt (image_index, image, cells, area).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="349" />
+            <location filename="../processing/help/__init__.py" line="350" />
             <source>Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the cells of blurred height steps to the nearer side, removes outliers (cells that depart from the confidence-weighted median of their window by more than the threshold and have too few neighbours at their height, so roof edges and corners survive), fills holes up to a maximum width by harmonic interpolation (holes at the foot of walls from the ground side only; wider holes stay nodata and are reported), and optionally smooths planar surfaces without blurring their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the statistics (removed outliers, filled cells, remaining holes) are returned and logged.</source>
             <translation>Bereinigt ein rohes DOM (z. B. das DOM der dichten Bildzuordnung aus dem OSGM-Schritt von TruOrtho) kachelweise: schiebt die Zellen verschliffener Höhensprünge auf die nähere Seite, entfernt Ausreißer (Zellen, die um mehr als die Schwelle vom konfidenzgewichteten Median ihres Fensters abweichen und zu wenige Nachbarn auf ihrer Höhe haben, sodass Dachkanten und Ecken erhalten bleiben), füllt Lücken bis zu einer Höchstbreite durch harmonische Interpolation (Lücken am Fuß von Wänden nur von der Bodenseite aus; breitere Lücken bleiben NoData und werden gemeldet) und glättet optional ebene Flächen, ohne ihre Kanten zu verwischen. Optional wird ein Geländemodell (DGM) durch Bodenfilterung nach Art von SMRF abgeleitet sowie das normalisierte DOM (Höhe über Gelände). Die Ausgaben behalten KBS, Raster und NoData der Eingabe; die Statistik (entfernte Ausreißer, gefüllte Zellen, verbleibende Lücken) wird zurückgegeben und protokolliert.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="360" />
+            <location filename="../processing/help/__init__.py" line="361" />
             <source>Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.</source>
             <translation>Rohes DOM: einkanaliges Raster mit einem projizierten KBS (Meter); seine NoData-Zellen sind Lücken.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="361" />
+            <location filename="../processing/help/__init__.py" line="362" />
             <source>Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum confidence are removed, less confident cells must agree better with their neighbours, and the median is weighted by confidence.</source>
             <translation>Optionales Konfidenzraster in [0, 1] (CONFIDENCE von OSGM): Zellen unter der Mindestkonfidenz werden entfernt, weniger zuverlässige Zellen müssen besser mit ihren Nachbarn übereinstimmen, und der Median wird mit der Konfidenz gewichtet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="364" />
+            <location filename="../processing/help/__init__.py" line="365" />
             <source>Largest departure from the neighbourhood median, metres (empty: 4 x the resolution).</source>
             <translation>Größte Abweichung vom Median der Nachbarschaft, Meter (leer: 4 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="366" />
+            <location filename="../processing/help/__init__.py" line="367" />
             <source>Side of the median window in cells (odd); a second pass uses twice the window.</source>
             <translation>Seitenlänge des Medianfensters in Zellen (ungerade); ein zweiter Durchlauf verwendet das doppelte Fenster.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="368" />
+            <location filename="../processing/help/__init__.py" line="369" />
             <source>Neighbours within the threshold of a cell's height that keep it although it departs from the median (edges, corners, thin structures).</source>
             <translation>Nachbarn innerhalb der Schwelle um die Höhe einer Zelle, die sie erhalten, obwohl sie vom Median abweicht (Kanten, Ecken, dünne Strukturen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="370" />
+            <location filename="../processing/help/__init__.py" line="371" />
             <source>With a confidence raster: cells below this confidence are removed.</source>
             <translation>Mit einem Konfidenzraster: Zellen unter dieser Konfidenz werden entfernt.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="371" />
+            <location filename="../processing/help/__init__.py" line="372" />
             <source>With a confidence raster: less confident cells are removed when they depart by more than the threshold from the median of the cells at least this confident in their 15 x 15 window (0: off).</source>
             <translation>Mit einem Konfidenzraster: weniger zuverlässige Zellen werden entfernt, wenn sie um mehr als die Schwelle vom Median der Zellen mit mindestens dieser Konfidenz in ihrem 15-x-15-Fenster abweichen (0: aus).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="374" />
+            <location filename="../processing/help/__init__.py" line="375" />
             <source>Largest hole width (metres) that is interpolated; 0 fills nothing.</source>
             <translation>Größte Lückenbreite (Meter), die interpoliert wird; 0 füllt nichts.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="375" />
+            <location filename="../processing/help/__init__.py" line="376" />
             <source>Height difference between two surfaces (a wall), metres: hole boundary cells that much above nearby boundary cells are not interpolated from.</source>
             <translation>Höhenunterschied zwischen zwei Oberflächen (eine Wand), Meter: Randzellen einer Lücke, die so viel höher als benachbarte Randzellen liegen, werden nicht zur Interpolation verwendet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="377" />
+            <location filename="../processing/help/__init__.py" line="378" />
             <source>Snap the cells of blurred height steps (between the two levels of their 5 x 5 window) to the nearer level.</source>
             <translation>Die Zellen verschliffener Höhensprünge (zwischen den beiden Niveaus ihres 5-x-5-Fensters) auf das nähere Niveau schieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="379" />
+            <location filename="../processing/help/__init__.py" line="380" />
             <source>Replace cells by a local plane fitted to the neighbours at their height (flat and pitched roofs, streets); steps stay sharp.</source>
             <translation>Zellen durch eine lokale Ebene ersetzen, die an die Nachbarn auf ihrer Höhe angepasst ist (Flach- und Schrägdächer, Straßen); Sprünge bleiben scharf.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="381" />
+            <location filename="../processing/help/__init__.py" line="382" />
             <source>Radius of the smoothing neighbourhood, cells.</source>
             <translation>Radius der Glättungsnachbarschaft, Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="382" />
+            <location filename="../processing/help/__init__.py" line="383" />
             <source>Neighbours within this height of a cell belong to its surface, metres (empty: 2.5 x the resolution).</source>
             <translation>Nachbarn innerhalb dieser Höhe um eine Zelle gehören zu ihrer Oberfläche, Meter (leer: 2,5 x die Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="384" />
+            <location filename="../processing/help/__init__.py" line="385" />
             <source>Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); the DTM is written on the DSM grid.</source>
             <translation>Zellgröße des Bodenfilters, Meter (leer: max(1 m, DOM-Auflösung)); das DGM wird auf dem DOM-Raster geschrieben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="386" />
+            <location filename="../processing/help/__init__.py" line="387" />
             <source>Largest opening radius of the ground filter, metres: more than half the width of the largest building.</source>
             <translation>Größter Öffnungsradius des Bodenfilters, Meter: mehr als die halbe Breite des größten Gebäudes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="388" />
+            <location filename="../processing/help/__init__.py" line="389" />
             <source>Terrain slope (rise over run) the ground filter keeps as ground.</source>
             <translation>Geländeneigung (Höhe pro Strecke), die der Bodenfilter als Boden behält.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="389" />
+            <location filename="../processing/help/__init__.py" line="390" />
             <source>Where the tiles are filtered; the filtered DSM and the statistics are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The terrain model is computed in QGIS's process.</source>
             <translation>Wo die Kacheln gefiltert werden; gefiltertes DOM und Statistik sind bei jeder Wahl identisch. inprocess: im Prozess von QGIS, eine Kachel nach der anderen auf allen Kernen (Standard). local: ein Dask-Cluster aus Worker-Prozessen auf diesem Rechner, der nur auf 127.0.0.1 lauscht (ein Worker je Kern, je mit Speichergrenze). scheduler: ein bestehender Dask-Cluster, gegeben durch SCHEDULER_ADDRESS; seine Worker müssen das DOM und das Konfidenzraster unter denselben Pfaden lesen (gemeinsamer Speicher) und TruOrtho installiert haben. Fällt ein Worker aus, berechnen die anderen seine Kacheln neu. Das Geländemodell wird im Prozess von QGIS berechnet.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="397" />
+            <location filename="../processing/help/__init__.py" line="398" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>Gefiltertes DOM (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="398" />
+            <location filename="../processing/help/__init__.py" line="399" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Optionales Geländemodell (GeoTIFF, float32, DOM-Raster).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="399" />
+            <location filename="../processing/help/__init__.py" line="400" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>Optionales normalisiertes DOM: DOM minus DGM, Höhen über dem Gelände.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="400" />
+            <location filename="../processing/help/__init__.py" line="401" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON: die Filterstatistik (und die des Bodenfilters).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="401" />
+            <location filename="../processing/help/__init__.py" line="402" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Als Ausreißer oder wegen geringer Konfidenz entfernte Zellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="402" />
+            <location filename="../processing/help/__init__.py" line="403" />
             <source>Hole cells interpolated.</source>
             <translation>Interpolierte Lückenzellen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="403" />
+            <location filename="../processing/help/__init__.py" line="404" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Lücken, breiter als MAX_HOLE, als NoData belassen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="408" />
+            <location filename="../processing/help/__init__.py" line="409" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Erzeugt eine Dreiecksvermaschung. Aus einem DOM: ein 2,5D-Netz, dessen Höhensprünge senkrechte Wände sind (kein Dreieck überspannt je einen Sprung) und dessen ebene und glatte Bereiche durch einen eingeschränkten Quadtree mit garantierter Höhenfehlerschranke an jedem Zellmittelpunkt ausgedünnt werden; Eckpunktfarben aus einem optionalen Orthobild. Aus einer Punktwolke (LAS/LAZ oder EPT, z. B. zusammengeführte Zuordnung von Schrägbildern): ein 2,5D-Delaunay-Netz je Referenzsystem, entlang seiner Blickrichtung gesehen (überlappende Schichten, wo Systeme dieselbe Oberfläche sehen; nicht wasserdicht). Schreibt PLY (binär) oder OBJ, im KBS oder in einem lokalen System, dessen Offset im Dateikopf vermerkt ist; truortho:trueortho liest es als SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="417" />
+            <location filename="../processing/help/__init__.py" line="418" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>DOM-Raster (projiziertes KBS) oder Punktwolke (.las, .laz oder eine EPT-ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="418" />
+            <location filename="../processing/help/__init__.py" line="419" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Optionales Orthobild (RGB) für die Eckpunktfarben eines DOM-Netzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="419" />
+            <location filename="../processing/help/__init__.py" line="420" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Größter Höhenunterschied zwischen Netz und DOM an einem Zellmittelpunkt, Meter (leer: halbe DOM-Auflösung).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="421" />
+            <location filename="../processing/help/__init__.py" line="422" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Kleinster Höhenunterschied zwischen benachbarten Zellen, der zur Wand wird, Meter.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="422" />
+            <location filename="../processing/help/__init__.py" line="423" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Steilste als geneigte Dreiecke erhaltene Neigung, Grad: die Sprungschwelle ist max(MIN_STEP, Auflösung x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="424" />
+            <location filename="../processing/help/__init__.py" line="425" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Größter Zellblock, den ein Dreieckspaar abdecken darf (eine Zweierpotenz).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="425" />
+            <location filename="../processing/help/__init__.py" line="426" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Punktwolken: längste Dreieckskante, Meter (leer: 4 x der mittlere Punktabstand).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="426" />
+            <location filename="../processing/help/__init__.py" line="427" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>CRS: Weltkoordinaten (PLY-Doubles). Lokal: Welt minus einem Offset, vermerkt als 'comment offset E N H' (PLY) oder '# offset E N H' (OBJ), für Viewer, die kleine Zahlen benötigen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="428" />
+            <location filename="../processing/help/__init__.py" line="429" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Das Netz: .ply (binär, Little-Endian, 'comment crs ...') oder .obj ('# crs ...', Eckpunktfarben als 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="430" />
+            <location filename="../processing/help/__init__.py" line="431" />
             <source>Number of vertices.</source>
             <translation>Anzahl der Eckpunkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="431" />
+            <location filename="../processing/help/__init__.py" line="432" />
             <source>Number of triangles.</source>
             <translation>Anzahl der Dreiecke.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="432" />
+            <location filename="../processing/help/__init__.py" line="433" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Anzahl der senkrechten Wanddreiecke (DOM-Netze).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="437" />
+            <location filename="../processing/help/__init__.py" line="438" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (menu Layer, Add Layer, Add Point Cloud Layer; choose ept.json).</source>
             <translation>Exportiert ein DOM als Punktwolke, ein Punkt je gültigem Zellmittelpunkt, mit Farben aus einem Orthobild und Konfidenz je Punkt aus einem Konfidenzraster: LAS 1.4 oder LAZ (Punktformat 7, KBS als WKT, Zusatzdimensionen 'confidence' und 'system' (das Referenzsystem), ein TruOrtho-VLR, der die Referenzsysteme beschreibt), lesbar mit PDAL, laspy, LAStools und CloudCompare. Daneben wird ein Entwine-Point-Tile-Datensatz (EPT) geschrieben: QGIS-Builds ohne PDAL (wie das QGIS 3.22 von Debian) öffnen ihn als Punktwolken-Layer (Menü Layer, Layer hinzufügen, Punktwolken-Layer hinzufügen; ept.json wählen).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="446" />
+            <location filename="../processing/help/__init__.py" line="447" />
             <source>DSM raster with a projected CRS.</source>
             <translation>DOM-Raster mit einem projizierten KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="447" />
+            <location filename="../processing/help/__init__.py" line="448" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Optionales Orthobild (RGB) für die Punktfarben.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="448" />
+            <location filename="../processing/help/__init__.py" line="449" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Optionales Konfidenzraster in [0, 1], gespeichert als Dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="449" />
+            <location filename="../processing/help/__init__.py" line="450" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Die Punktwolke (.laz komprimiert oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="450" />
+            <location filename="../processing/help/__init__.py" line="451" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Ordner des EPT-Datensatzes (ept.json, ept-data/, ept-hierarchy/); leer lassen, um ihn zu überspringen.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="451" />
+            <location filename="../processing/help/__init__.py" line="452" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Pfad der ept.json des EPT-Datensatzes.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="452" />
+            <location filename="../processing/help/__init__.py" line="453" />
             <source>Number of points written.</source>
             <translation>Anzahl der geschriebenen Punkte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="457" />
+            <location filename="../processing/help/__init__.py" line="458" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Führt Punktwolken mehrerer Referenzsysteme (z. B. das Nadir- und die Schrägsysteme der dichten Bildzuordnung) in einer LAS-1.4-/LAZ-Datei zusammen und behält dabei 'system' jedes Punktes (Dateien ohne dieses Attribut erhalten den Index ihrer Datei) und seine Konfidenz; dünnt optional Duplikate auf einem Voxelgitter aus und behält den zuverlässigsten Punkt jedes Voxels; schreibt optional einen EPT-Datensatz für QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="463" />
+            <location filename="../processing/help/__init__.py" line="464" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>LAS/LAZ-Dateien in einem KBS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="464" />
+            <location filename="../processing/help/__init__.py" line="465" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Voxelgröße für das Ausdünnen, Meter (leer: jeden Punkt behalten).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="465" />
+            <location filename="../processing/help/__init__.py" line="466" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Die zusammengeführte Punktwolke (.laz oder .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="466" />
+            <location filename="../processing/help/__init__.py" line="467" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Optionaler Ordner für einen EPT-Datensatz der zusammengeführten Wolke.</translation>
         </message>
@@ -2317,6 +2317,10 @@
             <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>Der Algorithmus {} ist in dieser Version nicht verfügbar.</translation>
+        </message>
+        <message>
+            <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
+            <translation type="obsolete">Berechnet ein True Orthophoto aus orientierten Bildern und einer Oberfläche (einem DOM-Raster wie dem von OSGM oder einem PLY/OBJ-Dreiecksnetz): jede Zelle wird aus einem Bild eingefärbt, das sie wirklich sieht, ermittelt mit einem Tiefenpuffer der Oberfläche je Bild (DOM-Zellen als flache Dächer mit senkrechten Wänden an Höhensprüngen, oder die Dreiecke des Netzes; Frustum- und Rückseiten-Culling). Unter den Bildern, die eine Zelle sehen, wird dasjenige mit der feinsten effektiven Bodenauflösung (Entfernung und Einfallswinkel auf der Oberfläche) bevorzugt; Dächer werden jeweils aus einem einzigen Bild texturiert, und die Nahtlinien folgen Höhensprüngen und meiden Stellen, an denen die Bilder nicht übereinstimmen (Label-Glättung), mit Überblendung über die Nähte nur zwischen Bildern, die beide die Zellen sehen. Farbkorrekturen je Bild in CIE L*a*b* (Verstärkung/Versatz je Kanal für Nicht-RGB-Daten) werden per Ausgleichung nach kleinsten Quadraten aus Zellen geschätzt, die mehrere Bilder sehen. Zellen, die kein Bild sieht, erhalten Alpha 0 und erscheinen in der Verdeckungsmaske. Kanalanzahl und Datentyp der Bilder bleiben erhalten (RGB, 16-Bit-panchromatisch, thermal). Die Verarbeitung läuft kachelweise mit begrenztem Speicher; Fortschritt und Abbruch je Kachel.</translation>
         </message>
         <message>
             <source>Height step between two search planes, metres; empty or 0 = the resolution.</source>

@@ -1520,346 +1520,346 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="282" />
-            <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
-            <translation>Calcule une orthophoto vraie à partir d'images orientées et d'une surface (un raster MNS comme celui d'OSGM, ou un maillage PLY/OBJ) : chaque cellule est colorée à partir d'une image qui la voit réellement, déterminée avec un tampon de profondeur de la surface par image (cellules du MNS comme sommets plats avec murs verticaux aux sauts de hauteur, ou les triangles du maillage ; élimination hors du champ de vue et des faces arrière). Parmi les images qui voient une cellule, celle de résolution au sol effective la plus fine (distance et incidence sur la surface) est préférée ; les toits sont texturés chacun à partir d'une seule image et les lignes de raccord suivent les discontinuités de hauteur et évitent les endroits où les images divergent (lissage des étiquettes), avec un fondu à travers les raccords uniquement entre images qui voient toutes deux les cellules. Des corrections colorimétriques par image dans CIE L*a*b* (gain/décalage par bande pour les données non RVB) sont estimées par moindres carrés à partir des cellules vues par plusieurs images. Les cellules qu'aucune image ne voit reçoivent un alpha de 0 et apparaissent dans le masque d'occultation. Le nombre de bandes et le type de données des images sont conservés (RVB, panchromatique 16 bits, thermique). Le traitement se fait par tuiles avec une mémoire bornée ; progression et annulation par tuile.</translation>
+            <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections (a gain/offset per RGB channel for white balance and exposure, then one in CIE L*a*b*; per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
+            <translation>Calcule une orthophoto vraie à partir d'images orientées et d'une surface (un raster MNS comme celui d'OSGM, ou un maillage PLY/OBJ) : chaque cellule est colorée à partir d'une image qui la voit réellement, déterminée avec un tampon de profondeur de la surface par image (cellules du MNS comme sommets plats avec murs verticaux aux sauts de hauteur, ou les triangles du maillage ; élimination hors du champ de vue et des faces arrière). Parmi les images qui voient une cellule, celle de résolution au sol effective la plus fine (distance et incidence sur la surface) est préférée ; les toits sont texturés chacun à partir d'une seule image et les lignes de raccord suivent les discontinuités de hauteur et évitent les endroits où les images divergent (lissage des étiquettes), avec un fondu à travers les raccords uniquement entre images qui voient toutes deux les cellules. Des corrections colorimétriques par image (un gain/décalage par canal RVB pour la balance des blancs et l'exposition, puis dans CIE L*a*b* ; gain/décalage par bande pour les données non RVB) sont estimées par moindres carrés à partir des cellules vues par plusieurs images. Les cellules qu'aucune image ne voit reçoivent un alpha de 0 et apparaissent dans le masque d'occultation. Le nombre de bandes et le type de données des images sont conservés (RVB, panchromatique 16 bits, thermique). Le traitement se fait par tuiles avec une mémoire bornée ; progression et annulation par tuile.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="296" />
+            <location filename="../processing/help/__init__.py" line="297" />
             <source>Orientation JSON (from Orient images or Import orientation); its images must be on disk.</source>
             <translation>JSON d'orientation (issu de Orienter les images ou Importer une orientation) ; ses images doivent être présentes sur le disque.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="298" />
+            <location filename="../processing/help/__init__.py" line="299" />
             <source>DSM GeoTIFF (any CRS; resampled onto the output grid by nearest neighbour) or a PLY/OBJ mesh. Heights must use the orientation's vertical datum. It must cover the extent.</source>
             <translation>GeoTIFF MNS (SCR quelconque ; rééchantillonné sur la grille de sortie au plus proche voisin) ou un maillage PLY/OBJ. Les hauteurs doivent être dans le référentiel altimétrique de l'orientation. Il doit couvrir l'emprise.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="300" />
+            <location filename="../processing/help/__init__.py" line="301" />
             <source>Output extent; default the surface's extent.</source>
             <translation>Emprise de sortie ; par défaut l'emprise de la surface.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="301" />
+            <location filename="../processing/help/__init__.py" line="302" />
             <source>Output cell size in units of the output CRS; 0 = the DSM's cell size.</source>
             <translation>Taille de cellule de sortie dans les unités du SCR de sortie ; 0 = taille de cellule du MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="302" />
+            <location filename="../processing/help/__init__.py" line="303" />
             <source>Output CRS; default the orientation's. When it differs, the computation runs on the output grid and cell centres are transformed to the orientation's CRS (images are resampled once).</source>
             <translation>SCR de sortie ; par défaut celui de l'orientation. S'il diffère, le calcul se fait sur la grille de sortie et les centres des cellules sont transformés dans le SCR de l'orientation (les images ne sont rééchantillonnées qu'une fois).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="305" />
+            <location filename="../processing/help/__init__.py" line="306" />
             <source>Estimate and apply per-image colour corrections before mosaicking.</source>
             <translation>Estimer et appliquer des corrections colorimétriques par image avant le mosaïquage.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="306" />
+            <location filename="../processing/help/__init__.py" line="307" />
             <source>With the colour correction: estimate a radial darkening towards the image corners per camera from the overlaps and remove it first. Images without vignetting get a factor of about 1; switch it off for images already corrected in processing.</source>
             <translation>Avec la correction colorimétrique : estimer par caméra, à partir des recouvrements, l'assombrissement radial vers les coins de l'image et le supprimer d'abord. Les images sans vignettage reçoivent un facteur proche de 1 ; à désactiver pour des images déjà corrigées au développement.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="313" />
+            <location filename="../processing/help/__init__.py" line="314" />
             <source>Largest off-nadir angle of the viewing ray (degrees) for an image to texture a cell; also bounds how far outside a tile occluders are searched.</source>
             <translation>Angle maximal du rayon de visée par rapport au nadir (degrés) pour qu'une image texture une cellule ; limite aussi jusqu'où, hors d'une tuile, les objets occultants sont recherchés.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="315" />
+            <location filename="../processing/help/__init__.py" line="316" />
             <source>Width of the feathering across seamlines, in cells (0 = hard seams).</source>
             <translation>Largeur du fondu aux lignes de raccord, en cellules (0 = raccords francs).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="316" />
+            <location filename="../processing/help/__init__.py" line="317" />
             <source>Tile side in cells; memory grows with its square and the images per tile.</source>
             <translation>Côté des tuiles en cellules ; la mémoire croît avec son carré et le nombre d'images par tuile.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="317" />
+            <location filename="../processing/help/__init__.py" line="318" />
             <source>Compression of the orthophoto. DEFLATE (the default), ZSTD and LZW are lossless: DEFLATE gives the smallest files and every GIS reads it; ZSTD (level 1) writes about twice as fast and about 9 % larger (GDAL 2.3 or later reads it); LZW is for older readers. JPEG is lossy (about a fifth of the size), for 8-bit RGB images only: RGB is stored as YCbCr with halved colour resolution, so colours blur across sharp edges such as building outlines (deliver and view with it; measure on a lossless one), and the alpha band becomes the file's internal mask. The source index and occlusion mask always stay lossless.</source>
             <translation>Compression de l'orthophoto. DEFLATE (par défaut), ZSTD et LZW sont sans perte : DEFLATE donne les fichiers les plus petits et tous les SIG le lisent ; ZSTD (niveau 1) écrit environ deux fois plus vite, pour des fichiers environ 9 % plus gros (lisible à partir de GDAL 2.3) ; LZW sert aux lecteurs anciens. JPEG est avec perte (environ un cinquième de la taille), pour les images RVB 8 bits seulement : le RVB est stocké en YCbCr avec une résolution des couleurs réduite de moitié, si bien que les couleurs bavent au travers des arêtes franches comme les contours des bâtiments (pour livrer et visualiser ; mesurer sur un fichier sans perte), et la bande alpha devient le masque interne du fichier. L'index des images sources et le masque d'occultation restent toujours sans perte.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="324" />
+            <location filename="../processing/help/__init__.py" line="325" />
             <source>JPEG quality (1-100) when COMPRESSION is JPEG.</source>
             <translation>Qualité JPEG (1-100) lorsque COMPRESSION vaut JPEG.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="325" />
+            <location filename="../processing/help/__init__.py" line="326" />
             <source>Where the tiles of the mosaic are computed; the true orthophoto, source index, occlusion mask and seamlines are identical with every choice. inprocess: in QGIS's process, the independent tiles of a wave in parallel threads (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the images and the surface at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The colour correction (on a decimated grid) is estimated in QGIS's process. Finished tiles are kept in a folder beside the output (its name plus '.tiles') until the run succeeds, so a rerun with the same inputs and parameters after a crash reuses them.</source>
             <translation>Où les tuiles de la mosaïque sont calculées ; l'orthophoto vraie, l'index des images sources, le masque d'occultation et les lignes de raccord sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, les tuiles indépendantes d'une vague en parallèle dans des threads (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire les images et la surface aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. La correction colorimétrique (sur une grille décimée) est estimée dans le processus de QGIS. Les tuiles terminées sont gardées dans un dossier à côté de la sortie (son nom suivi de « .tiles ») jusqu'à la réussite du traitement, de sorte qu'une nouvelle exécution avec les mêmes entrées et paramètres après un plantage les réutilise.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="337" />
+            <location filename="../processing/help/__init__.py" line="338" />
             <source>GeoTIFF with the images' bands and data type plus an alpha band (an internal mask with JPEG compression), tiled, with overviews, Cloud-Optimized GeoTIFF layout.</source>
             <translation>GeoTIFF avec les bandes et le type de données des images plus une bande alpha (un masque interne avec la compression JPEG), tuilé, avec aperçus, au format Cloud-Optimized GeoTIFF.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="339" />
+            <location filename="../processing/help/__init__.py" line="340" />
             <source>Int16 GeoTIFF: index (0-based, orientation order) of the image each cell comes from; -1 = nodata.</source>
             <translation>GeoTIFF Int16 : index (à partir de 0, dans l'ordre de l'orientation) de l'image dont provient chaque cellule ; -1 = NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="341" />
+            <location filename="../processing/help/__init__.py" line="342" />
             <source>UInt8 GeoTIFF: 1 where no image sees the cell, 0 where seen, 255 where the surface has no data.</source>
             <translation>GeoTIFF UInt8 : 1 là où aucune image ne voit la cellule, 0 là où elle est vue, 255 là où la surface n'a pas de données.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="343" />
+            <location filename="../processing/help/__init__.py" line="344" />
             <source>Polygons, one feature per source image: the cells it colours (image_index, image, cells, area).</source>
             <translation>Polygones, une entité par image source : les cellules qu'elle colore (image_index, image, cells, area).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="349" />
+            <location filename="../processing/help/__init__.py" line="350" />
             <source>Cleans a raw DSM (e.g. the dense-matching DSM of TruOrtho's OSGM step) tile by tile: snaps the cells of blurred height steps to the nearer side, removes outliers (cells that depart from the confidence-weighted median of their window by more than the threshold and have too few neighbours at their height, so roof edges and corners survive), fills holes up to a maximum width by harmonic interpolation (holes at the foot of walls from the ground side only; wider holes stay nodata and are reported), and optionally smooths planar surfaces without blurring their edges. Optionally derives a terrain model (DTM) by SMRF-style ground filtering and the normalised DSM (height above terrain). Outputs keep the input's CRS, grid and nodata; the statistics (removed outliers, filled cells, remaining holes) are returned and logged.</source>
             <translation>Nettoie un MNS brut (par ex. le MNS d'appariement dense de l'étape OSGM de TruOrtho) tuile par tuile : ramène les cellules des sauts de hauteur flous du côté le plus proche, supprime les valeurs aberrantes (cellules qui s'écartent de plus que le seuil de la médiane pondérée par la confiance de leur fenêtre et ont trop peu de voisins à leur hauteur, de sorte que les bords et les angles des toits sont préservés), comble les trous jusqu'à une largeur maximale par interpolation harmonique (trous au pied des murs uniquement depuis le côté du sol ; les trous plus larges restent en NoData et sont signalés), et lisse en option les surfaces planes sans en estomper les arêtes. Dérive en option un modèle numérique de terrain (MNT) par un filtrage du sol de type SMRF, ainsi que le MNS normalisé (hauteur au-dessus du terrain). Les sorties conservent le SCR, la grille et le NoData de l'entrée ; les statistiques (valeurs aberrantes supprimées, cellules comblées, trous restants) sont renvoyées et journalisées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="360" />
+            <location filename="../processing/help/__init__.py" line="361" />
             <source>Raw DSM: single-band raster with a projected CRS (metres); its nodata cells are holes.</source>
             <translation>MNS brut : raster à une bande dans un SCR projeté (mètres) ; ses cellules NoData sont des trous.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="361" />
+            <location filename="../processing/help/__init__.py" line="362" />
             <source>Optional confidence raster in [0, 1] (OSGM's CONFIDENCE): cells below the minimum confidence are removed, less confident cells must agree better with their neighbours, and the median is weighted by confidence.</source>
             <translation>Raster de confiance facultatif dans [0, 1] (CONFIDENCE d'OSGM) : les cellules sous la confiance minimale sont supprimées, les cellules moins fiables doivent mieux concorder avec leurs voisines, et la médiane est pondérée par la confiance.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="364" />
+            <location filename="../processing/help/__init__.py" line="365" />
             <source>Largest departure from the neighbourhood median, metres (empty: 4 x the resolution).</source>
             <translation>Écart maximal à la médiane du voisinage, en mètres (vide : 4 x la résolution).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="366" />
+            <location filename="../processing/help/__init__.py" line="367" />
             <source>Side of the median window in cells (odd); a second pass uses twice the window.</source>
             <translation>Côté de la fenêtre médiane en cellules (impair) ; une seconde passe utilise une fenêtre deux fois plus grande.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="368" />
+            <location filename="../processing/help/__init__.py" line="369" />
             <source>Neighbours within the threshold of a cell's height that keep it although it departs from the median (edges, corners, thin structures).</source>
             <translation>Voisins à moins du seuil de la hauteur d'une cellule qui la conservent bien qu'elle s'écarte de la médiane (arêtes, angles, structures fines).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="370" />
+            <location filename="../processing/help/__init__.py" line="371" />
             <source>With a confidence raster: cells below this confidence are removed.</source>
             <translation>Avec un raster de confiance : les cellules sous cette confiance sont supprimées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="371" />
+            <location filename="../processing/help/__init__.py" line="372" />
             <source>With a confidence raster: less confident cells are removed when they depart by more than the threshold from the median of the cells at least this confident in their 15 x 15 window (0: off).</source>
             <translation>Avec un raster de confiance : les cellules moins fiables sont supprimées lorsqu'elles s'écartent de plus que le seuil de la médiane des cellules ayant au moins cette confiance dans leur fenêtre de 15 x 15 (0 : désactivé).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="374" />
+            <location filename="../processing/help/__init__.py" line="375" />
             <source>Largest hole width (metres) that is interpolated; 0 fills nothing.</source>
             <translation>Largeur maximale de trou (mètres) interpolée ; 0 ne comble rien.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="375" />
+            <location filename="../processing/help/__init__.py" line="376" />
             <source>Height difference between two surfaces (a wall), metres: hole boundary cells that much above nearby boundary cells are not interpolated from.</source>
             <translation>Différence de hauteur entre deux surfaces (un mur), en mètres : les cellules du bord d'un trou situées d'autant plus haut que les cellules de bord voisines ne servent pas à l'interpolation.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="377" />
+            <location filename="../processing/help/__init__.py" line="378" />
             <source>Snap the cells of blurred height steps (between the two levels of their 5 x 5 window) to the nearer level.</source>
             <translation>Ramener les cellules des sauts de hauteur flous (entre les deux niveaux de leur fenêtre de 5 x 5) au niveau le plus proche.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="379" />
+            <location filename="../processing/help/__init__.py" line="380" />
             <source>Replace cells by a local plane fitted to the neighbours at their height (flat and pitched roofs, streets); steps stay sharp.</source>
             <translation>Remplacer les cellules par un plan local ajusté aux voisines à leur hauteur (toits plats et en pente, rues) ; les sauts restent nets.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="381" />
+            <location filename="../processing/help/__init__.py" line="382" />
             <source>Radius of the smoothing neighbourhood, cells.</source>
             <translation>Rayon du voisinage de lissage, en cellules.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="382" />
+            <location filename="../processing/help/__init__.py" line="383" />
             <source>Neighbours within this height of a cell belong to its surface, metres (empty: 2.5 x the resolution).</source>
             <translation>Les voisines à moins de cette hauteur d'une cellule appartiennent à sa surface, en mètres (vide : 2,5 x la résolution).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="384" />
+            <location filename="../processing/help/__init__.py" line="385" />
             <source>Cell size of the ground filter, metres (empty: max(1 m, the DSM resolution)); the DTM is written on the DSM grid.</source>
             <translation>Taille de cellule du filtre de sol, en mètres (vide : max(1 m, résolution du MNS)) ; le MNT est écrit sur la grille du MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="386" />
+            <location filename="../processing/help/__init__.py" line="387" />
             <source>Largest opening radius of the ground filter, metres: more than half the width of the largest building.</source>
             <translation>Rayon d'ouverture maximal du filtre de sol, en mètres : plus de la moitié de la largeur du plus grand bâtiment.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="388" />
+            <location filename="../processing/help/__init__.py" line="389" />
             <source>Terrain slope (rise over run) the ground filter keeps as ground.</source>
             <translation>Pente du terrain (dénivelé sur distance) que le filtre de sol conserve comme sol.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="389" />
+            <location filename="../processing/help/__init__.py" line="390" />
             <source>Where the tiles are filtered; the filtered DSM and the statistics are identical with every choice. inprocess: in QGIS's process, one tile after the other on all cores (the default). local: a Dask cluster of worker processes on this computer, listening on 127.0.0.1 only (one worker per core, a memory limit each). scheduler: an existing Dask cluster given by SCHEDULER_ADDRESS; its workers must read the DSM and the confidence raster at the same paths (shared storage) and have TruOrtho installed. A worker that dies has its tiles recomputed by the others. The terrain model is computed in QGIS's process.</source>
             <translation>Où les tuiles sont filtrées ; le MNS filtré et les statistiques sont identiques quel que soit le choix. inprocess : dans le processus de QGIS, une tuile après l'autre sur tous les cœurs (par défaut). local : une grappe Dask de processus de travail sur cet ordinateur, à l'écoute sur 127.0.0.1 seulement (un processus par cœur, chacun avec une limite de mémoire). scheduler : une grappe Dask existante, donnée par SCHEDULER_ADDRESS ; ses processus de travail doivent lire le MNS et le raster de confiance aux mêmes chemins (stockage partagé) et avoir TruOrtho installé. Les tuiles d'un processus de travail qui meurt sont recalculées par les autres. Le modèle de terrain est calculé dans le processus de QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="397" />
+            <location filename="../processing/help/__init__.py" line="398" />
             <source>Filtered DSM (GeoTIFF, float32).</source>
             <translation>MNS filtré (GeoTIFF, float32).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="398" />
+            <location filename="../processing/help/__init__.py" line="399" />
             <source>Optional terrain model (GeoTIFF, float32, DSM grid).</source>
             <translation>Modèle numérique de terrain facultatif (GeoTIFF, float32, grille du MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="399" />
+            <location filename="../processing/help/__init__.py" line="400" />
             <source>Optional normalised DSM: DSM minus DTM, heights above the terrain.</source>
             <translation>MNS normalisé facultatif : MNS moins MNT, hauteurs au-dessus du terrain.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="400" />
+            <location filename="../processing/help/__init__.py" line="401" />
             <source>JSON: the filter statistics (and the ground filter's).</source>
             <translation>JSON : les statistiques du filtre (et celles du filtre de sol).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="401" />
+            <location filename="../processing/help/__init__.py" line="402" />
             <source>Cells removed as outliers or for low confidence.</source>
             <translation>Cellules supprimées comme valeurs aberrantes ou pour confiance insuffisante.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="402" />
+            <location filename="../processing/help/__init__.py" line="403" />
             <source>Hole cells interpolated.</source>
             <translation>Cellules de trous interpolées.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="403" />
+            <location filename="../processing/help/__init__.py" line="404" />
             <source>Holes wider than MAX_HOLE, left as nodata.</source>
             <translation>Trous plus larges que MAX_HOLE, laissés en NoData.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="408" />
+            <location filename="../processing/help/__init__.py" line="409" />
             <source>Builds a triangle mesh. From a DSM: a 2.5D mesh whose height steps are vertical walls (no triangle ever spans a step) and whose flat and smooth areas are decimated by a restricted quadtree with a guaranteed vertical error bound at every cell centre; vertex colours from an optional orthoimage. From a point cloud (LAS/LAZ or EPT, e.g. merged oblique matching): one 2.5D Delaunay mesh per reference system, seen along its viewing direction (overlapping layers where systems see the same surface; not watertight). Writes PLY (binary) or OBJ, in the CRS or in a local frame whose offset is recorded in the header; truortho:trueortho reads it as SURFACE.</source>
             <translation>Construit un maillage triangulaire. À partir d'un MNS : un maillage 2,5D dont les sauts de hauteur sont des murs verticaux (aucun triangle n'enjambe jamais un saut) et dont les zones planes et lisses sont décimées par un quadtree restreint avec une borne garantie de l'erreur verticale au centre de chaque cellule ; couleurs des sommets issues d'une orthoimage facultative. À partir d'un nuage de points (LAS/LAZ ou EPT, par ex. l'appariement fusionné d'images obliques) : un maillage de Delaunay 2,5D par système de référence, vu selon sa direction de visée (couches superposées là où des systèmes voient la même surface ; non étanche). Écrit du PLY (binaire) ou de l'OBJ, dans le SCR ou dans un repère local dont le décalage est consigné dans l'en-tête ; truortho:trueortho le lit comme SURFACE.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="417" />
+            <location filename="../processing/help/__init__.py" line="418" />
             <source>DSM raster (projected CRS) or point cloud (.las, .laz, or an EPT ept.json).</source>
             <translation>Raster MNS (SCR projeté) ou nuage de points (.las, .laz, ou un ept.json EPT).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="418" />
+            <location filename="../processing/help/__init__.py" line="419" />
             <source>Optional orthoimage (RGB) for the vertex colours of a DSM mesh.</source>
             <translation>Orthoimage facultative (RVB) pour les couleurs des sommets d'un maillage de MNS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="419" />
+            <location filename="../processing/help/__init__.py" line="420" />
             <source>Largest vertical difference between mesh and DSM at any cell centre, metres (empty: half the DSM resolution).</source>
             <translation>Écart vertical maximal entre le maillage et le MNS en tout centre de cellule, en mètres (vide : la moitié de la résolution du MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="421" />
+            <location filename="../processing/help/__init__.py" line="422" />
             <source>Smallest height difference between neighbouring cells that becomes a wall, metres.</source>
             <translation>Plus petite différence de hauteur entre cellules voisines qui devient un mur, en mètres.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="422" />
+            <location filename="../processing/help/__init__.py" line="423" />
             <source>Steepest slope kept as sloping triangles, degrees: the step threshold is max(MIN_STEP, resolution x tan(MAX_SLOPE)).</source>
             <translation>Pente la plus forte conservée en triangles inclinés, en degrés : le seuil de saut vaut max(MIN_STEP, résolution x tan(MAX_SLOPE)).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="424" />
+            <location filename="../processing/help/__init__.py" line="425" />
             <source>Largest block of cells one pair of triangles may cover (a power of two).</source>
             <translation>Plus grand bloc de cellules qu'une paire de triangles peut couvrir (une puissance de deux).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="425" />
+            <location filename="../processing/help/__init__.py" line="426" />
             <source>Point clouds: longest triangle edge, metres (empty: 4 x the median point spacing).</source>
             <translation>Nuages de points : arête de triangle la plus longue, en mètres (vide : 4 x l'espacement médian des points).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="426" />
+            <location filename="../processing/help/__init__.py" line="427" />
             <source>CRS: world coordinates (PLY doubles). Local: world minus an offset recorded as 'comment offset E N H' (PLY) or '# offset E N H' (OBJ), for viewers that need small numbers.</source>
             <translation>SCR : coordonnées terrain (doubles PLY). Local : terrain moins un décalage consigné sous la forme 'comment offset E N H' (PLY) ou '# offset E N H' (OBJ), pour les visionneuses qui ont besoin de petits nombres.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="428" />
+            <location filename="../processing/help/__init__.py" line="429" />
             <source>The mesh: .ply (binary little-endian, 'comment crs ...') or .obj ('# crs ...', vertex colours as 'v x y z r g b').</source>
             <translation>Le maillage : .ply (binaire petit-boutiste, 'comment crs ...') ou .obj ('# crs ...', couleurs des sommets sous la forme 'v x y z r g b').</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="430" />
+            <location filename="../processing/help/__init__.py" line="431" />
             <source>Number of vertices.</source>
             <translation>Nombre de sommets.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="431" />
+            <location filename="../processing/help/__init__.py" line="432" />
             <source>Number of triangles.</source>
             <translation>Nombre de triangles.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="432" />
+            <location filename="../processing/help/__init__.py" line="433" />
             <source>Number of vertical wall triangles (DSM meshes).</source>
             <translation>Nombre de triangles de murs verticaux (maillages de MNS).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="437" />
+            <location filename="../processing/help/__init__.py" line="438" />
             <source>Exports a DSM as a point cloud, one point per valid cell centre, with colours from an orthoimage and per-point confidence from a confidence raster: LAS 1.4 or LAZ (point format 7, CRS as WKT, extra dimensions 'confidence' and 'system' (the reference system), a TruOrtho VLR describing the reference systems), readable by PDAL, laspy, LAStools and CloudCompare. An Entwine Point Tile (EPT) dataset is written beside it: QGIS builds without PDAL (as Debian's QGIS 3.22) open it as a point cloud layer (menu Layer, Add Layer, Add Point Cloud Layer; choose ept.json).</source>
             <translation>Exporte un MNS en nuage de points, un point par centre de cellule valide, avec les couleurs d'une orthoimage et une confiance par point issue d'un raster de confiance : LAS 1.4 ou LAZ (format de point 7, SCR en WKT, dimensions supplémentaires 'confidence' et 'system' (le système de référence), un VLR TruOrtho décrivant les systèmes de référence), lisible par PDAL, laspy, LAStools et CloudCompare. Un jeu de données Entwine Point Tile (EPT) est écrit à côté : les versions de QGIS sans PDAL (comme QGIS 3.22 de Debian) l'ouvrent comme couche nuage de points (menu Couche, Ajouter une couche, Ajouter une couche nuage de points ; choisir ept.json).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="446" />
+            <location filename="../processing/help/__init__.py" line="447" />
             <source>DSM raster with a projected CRS.</source>
             <translation>Raster MNS dans un SCR projeté.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="447" />
+            <location filename="../processing/help/__init__.py" line="448" />
             <source>Optional orthoimage (RGB) for the point colours.</source>
             <translation>Orthoimage facultative (RVB) pour les couleurs des points.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="448" />
+            <location filename="../processing/help/__init__.py" line="449" />
             <source>Optional confidence raster in [0, 1], stored as the 'confidence' dimension.</source>
             <translation>Raster de confiance facultatif dans [0, 1], stocké comme dimension 'confidence'.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="449" />
+            <location filename="../processing/help/__init__.py" line="450" />
             <source>The point cloud (.laz compressed, or .las).</source>
             <translation>Le nuage de points (.laz compressé, ou .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="450" />
+            <location filename="../processing/help/__init__.py" line="451" />
             <source>Folder of the EPT dataset (ept.json, ept-data/, ept-hierarchy/); leave empty to skip.</source>
             <translation>Dossier du jeu de données EPT (ept.json, ept-data/, ept-hierarchy/) ; laisser vide pour ne pas l'écrire.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="451" />
+            <location filename="../processing/help/__init__.py" line="452" />
             <source>Path of the EPT dataset's ept.json.</source>
             <translation>Chemin du fichier ept.json du jeu de données EPT.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="452" />
+            <location filename="../processing/help/__init__.py" line="453" />
             <source>Number of points written.</source>
             <translation>Nombre de points écrits.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="457" />
+            <location filename="../processing/help/__init__.py" line="458" />
             <source>Merges point clouds of several reference systems (e.g. the nadir and oblique systems of dense matching) into one LAS 1.4 / LAZ file, keeping each point's 'system' (files without it get the index of their file) and confidence; optionally thins duplicates on a voxel grid, keeping the most confident point of each voxel; optionally writes an EPT dataset for QGIS.</source>
             <translation>Fusionne des nuages de points de plusieurs systèmes de référence (par ex. les systèmes nadir et obliques de l'appariement dense) en un seul fichier LAS 1.4 / LAZ, en conservant le 'system' de chaque point (les fichiers qui n'en ont pas reçoivent l'index de leur fichier) et sa confiance ; éclaircit en option les doublons sur une grille de voxels en gardant le point le plus fiable de chaque voxel ; écrit en option un jeu de données EPT pour QGIS.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="463" />
+            <location filename="../processing/help/__init__.py" line="464" />
             <source>LAS/LAZ files in one CRS.</source>
             <translation>Fichiers LAS/LAZ dans un même SCR.</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="464" />
+            <location filename="../processing/help/__init__.py" line="465" />
             <source>Voxel size for thinning, metres (empty: keep every point).</source>
             <translation>Taille des voxels pour l'éclaircissement, en mètres (vide : conserver tous les points).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="465" />
+            <location filename="../processing/help/__init__.py" line="466" />
             <source>The merged point cloud (.laz or .las).</source>
             <translation>Le nuage de points fusionné (.laz ou .las).</translation>
         </message>
         <message>
-            <location filename="../processing/help/__init__.py" line="466" />
+            <location filename="../processing/help/__init__.py" line="467" />
             <source>Optional folder for an EPT dataset of the merged cloud.</source>
             <translation>Dossier facultatif pour un jeu de données EPT du nuage fusionné.</translation>
         </message>
@@ -2317,6 +2317,10 @@
             <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>L'algorithme {} n'est pas disponible dans cette version.</translation>
+        </message>
+        <message>
+            <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
+            <translation type="obsolete">Calcule une orthophoto vraie à partir d'images orientées et d'une surface (un raster MNS comme celui d'OSGM, ou un maillage PLY/OBJ) : chaque cellule est colorée à partir d'une image qui la voit réellement, déterminée avec un tampon de profondeur de la surface par image (cellules du MNS comme sommets plats avec murs verticaux aux sauts de hauteur, ou les triangles du maillage ; élimination hors du champ de vue et des faces arrière). Parmi les images qui voient une cellule, celle de résolution au sol effective la plus fine (distance et incidence sur la surface) est préférée ; les toits sont texturés chacun à partir d'une seule image et les lignes de raccord suivent les discontinuités de hauteur et évitent les endroits où les images divergent (lissage des étiquettes), avec un fondu à travers les raccords uniquement entre images qui voient toutes deux les cellules. Des corrections colorimétriques par image dans CIE L*a*b* (gain/décalage par bande pour les données non RVB) sont estimées par moindres carrés à partir des cellules vues par plusieurs images. Les cellules qu'aucune image ne voit reçoivent un alpha de 0 et apparaissent dans le masque d'occultation. Le nombre de bandes et le type de données des images sont conservés (RVB, panchromatique 16 bits, thermique). Le traitement se fait par tuiles avec une mémoire bornée ; progression et annulation par tuile.</translation>
         </message>
         <message>
             <source>Height step between two search planes, metres; empty or 0 = the resolution.</source>

@@ -6,13 +6,20 @@ Every image ``i`` gets a gain and an offset per channel, ``y = g_ic * x + o_ic``
 applied to its samples before they enter the mosaic:
 
 * RGB data (3 or 4 bands, the first three taken as sRGB-encoded red, green,
-  blue scaled to [0, 1] by the dtype's maximum; float data as given): the
-  channels are CIE L*a*b* (D65), so lightness and the two chroma axes are
-  corrected separately and perceptually evenly (:func:`rgb_to_lab`,
-  :func:`lab_to_rgb`); a 4th band (alpha or NIR) is corrected per band like
-  non-RGB data.
+  blue scaled to [0, 1] by the dtype's maximum; float data as given): two stages.
+  First a gain and an offset per colour channel on the values as stored
+  (``rgb_gain``, ``rgb_offset``, in the data's units): a camera's white balance and
+  exposure scale each channel separately (in linear light, which the sRGB curve keeps
+  a gain per channel, close enough), and its black level shifts it. Then a gain and
+  an offset per channel of CIE L*a*b* (D65) on the result, so lightness and the two
+  chroma axes are matched separately and perceptually evenly (:func:`rgb_to_lab`,
+  :func:`lab_to_rgb`): what differs in tone rather than per channel. An L*a*b* model
+  alone cannot undo a white balance: a channel's gain moves a* and b* by an amount
+  that grows with the lightness (``a* = 500 (f(X) - f(Y))``), which no offset of a*
+  matches over dark and bright surfaces at once. A 4th band (alpha or NIR) is
+  corrected per band like non-RGB data, in the second stage.
 * any other band count (panchromatic, thermal, multispectral): the equivalent
-  per-band linear model in the data's own units.
+  per-band linear model in the data's own units (one stage).
 
 Vignetting (:func:`estimate_vignetting`): before the gains and offsets, a radial
 fall-off per camera, ``V(rho) = exp(c1 rho^2 + c2 rho^4)`` with ``rho`` the distance from the
@@ -23,20 +30,18 @@ observations of a cell, ``log Y_a - log Y_b = u_a - u_b + log V_A(rho_a) - log V
 Huber-reweighted least squares; a camera whose fit is poorly determined (its observations span
 too few radii) or implausible (``V`` at the corner outside [0.3, 1.15]) keeps ``V = 1``.
 
-Estimation (:func:`estimate_corrections`)
------------------------------------------
-From cells seen by several images: for every pair of images, the robust
-moments (median, half the 16-84 % spread) of both images over the cells they
-share. Gains equalise the spreads (``log g_a - log g_b = log s_b - log s_a``),
-offsets then the medians, each solved by least squares over the image pairs
-(weight the square root of the shared cells, Huber-reweighted, so a pair spoilt
-by occlusions or moving objects does not bias the fit); the level of the whole
-block is fixed by mean gain 1 and mean offset 0, and a weak prior towards
-the identity keeps images without overlap determined. Matching moments instead
-of regressing one image's samples on another's keeps the gains unbiased when
-the samples of a cell correlate weakly between images (fine cells,
-vegetation), where regression shrinks them (see :func:`_moment_match`). The
-result reports the RMS disagreement between images before and after.
+Estimation (:func:`estimate_corrections`; both stages: :func:`estimate_colour_model`)
+------------------------------------------------------------------------------------
+Each stage the same way, the second on the samples the first corrected. From cells seen by several
+images: for every pair of images, the robust moments (median, half the 16-84 % spread) of both
+images over the cells they share. Gains equalise the spreads (``log g_a - log g_b = log s_b - log
+s_a``), offsets then the medians, each solved by least squares over the image pairs (weight the
+square root of the shared cells, Huber-reweighted, so a pair spoilt by occlusions or moving objects
+does not bias the fit); the level of the whole block is fixed by mean gain 1 and mean offset 0, and
+a weak prior towards the identity keeps images without overlap determined. Matching moments instead
+of regressing one image's samples on another's keeps the gains unbiased when the samples of a cell
+correlate weakly between images (fine cells, vegetation), where regression shrinks them (see
+:func:`_moment_match`). The result reports the RMS disagreement between images before and after.
 """
 
 from __future__ import annotations
@@ -120,13 +125,17 @@ def from_channels(channels: np.ndarray, dtype) -> np.ndarray:
 
 @dataclass
 class ColorCorrection:
-    """Per-image, per-channel ``gain`` and ``offset`` (channels of :func:`to_channels`).
+    """Per-image, per-channel ``gain`` and ``offset`` (channels of :func:`to_channels`), after an
+    optional first stage per RGB channel (module docstring).
 
     Attributes
     ----------
     gain, offset : (n_images, channels) float64
     lab : bool
         Channels 0-2 are L*a*b*.
+    rgb_gain, rgb_offset : (n_images, 3) float64 or None
+        The first stage: gain and offset of the first three bands as stored (data units),
+        applied before ``gain`` and ``offset``.
     stats : dict
         ``observations``, ``pairs``, ``rms_before``, ``rms_after``, ``median_before``,
         ``median_after`` (absolute pair disagreement, channel units), ``images_constrained``.
@@ -141,6 +150,8 @@ class ColorCorrection:
     #: (n_images, 2) principal point (full-resolution pixels) and (n_images,) 1 / half diagonal.
     centre: np.ndarray | None = None
     inv_norm: np.ndarray | None = None
+    rgb_gain: np.ndarray | None = None
+    rgb_offset: np.ndarray | None = None
 
     @classmethod
     def identity(cls, n_images: int, bands: int) -> ColorCorrection:
@@ -149,23 +160,39 @@ class ColorCorrection:
     def has_vignetting(self, i: int) -> bool:
         return self.vignetting is not None and bool(np.any(self.vignetting[i] != 0.0))
 
+    def has_rgb_stage(self, i: int) -> bool:
+        return (
+            self.rgb_gain is not None
+            and self.rgb_offset is not None
+            and bool(np.any(self.rgb_gain[i] != 1.0) or np.any(self.rgb_offset[i] != 0.0))
+        )
+
     def is_identity(self, i: int) -> bool:
-        return bool(
-            np.all(self.gain[i] == 1.0) and np.all(self.offset[i] == 0.0)
-        ) and not self.has_vignetting(i)
+        return (
+            bool(np.all(self.gain[i] == 1.0) and np.all(self.offset[i] == 0.0))
+            and not self.has_vignetting(i)
+            and not self.has_rgb_stage(i)
+        )
+
+    def _rgb_stage(self, i: int, bands: int) -> tuple[np.ndarray, np.ndarray]:
+        """The first stage as per-band arrays over ``bands`` (identity beyond the first three)."""
+        assert self.rgb_gain is not None and self.rgb_offset is not None
+        g, o = np.ones(bands), np.zeros(bands)
+        g[:3], o[:3] = self.rgb_gain[i], self.rgb_offset[i]
+        return g, o
 
     def apply(self, i: int, samples: np.ndarray, dtype) -> np.ndarray:
         """Corrected samples (N, bands) of image ``i`` in the data's dtype range (float64)."""
         s = np.asarray(samples, dtype=np.float64)
         if self.is_identity(i) or len(s) == 0:
             return s
-        ch = to_channels(s, dtype) * self.gain[i] + self.offset[i]
-        out = from_channels(ch, dtype)
         dt = np.dtype(dtype)
-        if dt.kind in "ui":
-            info = np.iinfo(dt)
-            out = np.clip(out, info.min, info.max)
-        return out
+        lo, hi = (np.iinfo(dt).min, np.iinfo(dt).max) if dt.kind in "ui" else (-np.inf, np.inf)
+        if self.has_rgb_stage(i) and uses_lab(s.shape[1]):
+            g, o = self._rgb_stage(i, s.shape[1])
+            s = np.clip(s * g + o, lo, hi)
+        ch = to_channels(s, dtype) * self.gain[i] + self.offset[i]
+        return np.clip(from_channels(ch, dtype), lo, hi)
 
     def apply_inplace(self, i: int, colours: np.ndarray, mask: np.ndarray, dtype, uv=None) -> None:
         """:meth:`apply` to the samples ``colours`` (..., bands) float32 of image ``i`` where ``mask``
@@ -199,6 +226,24 @@ class ColorCorrection:
                 _LUT_N,
                 _LUT_TOP,
             )
+        if self.has_rgb_stage(i) and uses_lab(colours.shape[-1]):
+            g, o = self._rgb_stage(i, colours.shape[-1])
+            _correct(
+                colours.reshape(-1, colours.shape[-1]),
+                np.ascontiguousarray(mask).reshape(-1),
+                g,
+                o,
+                False,
+                value_scale(dt),
+                lo,
+                hi,
+                _M,
+                _M_INV,
+                _WHITE,
+                _LUTS,
+                _LUT_N,
+                _LUT_TOP,
+            )
         if np.all(self.gain[i] == 1.0) and np.all(self.offset[i] == 0.0):
             return
         _correct(
@@ -220,16 +265,19 @@ class ColorCorrection:
 
     def as_dict(self, names: list[str] | None = None) -> dict:
         rows: list[dict] = []
+        rgb = self.rgb_gain is not None and self.rgb_offset is not None
         for i in range(len(self.gain)):
-            rows.append(
-                {
-                    "image": names[i] if names else i,
-                    "gain": [round(float(v), 5) for v in self.gain[i]],
-                    "offset": [round(float(v), 5) for v in self.offset[i]],
-                }
-            )
+            row: dict = {"image": names[i] if names else i}
+            if rgb:
+                assert self.rgb_gain is not None and self.rgb_offset is not None
+                row["rgb_gain"] = [round(float(v), 5) for v in self.rgb_gain[i]]
+                row["rgb_offset"] = [round(float(v), 5) for v in self.rgb_offset[i]]
+            row["gain"] = [round(float(v), 5) for v in self.gain[i]]
+            row["offset"] = [round(float(v), 5) for v in self.offset[i]]
+            rows.append(row)
+        model = "L*a*b* gain/offset" if self.lab else "per-band gain/offset"
         out = {
-            "model": "L*a*b* gain/offset" if self.lab else "per-band gain/offset",
+            "model": f"per-channel RGB gain/offset, then {model}" if rgb else model,
             "images": rows,
             **self.stats,
         }
@@ -470,6 +518,7 @@ def estimate_corrections(
     min_pair: int = 30,
     per_pair: int = 2_000,
     budget: int = 400_000,
+    values_before=None,
 ) -> ColorCorrection:
     """Least-squares gains and offsets from multiply observed cells.
 
@@ -510,6 +559,9 @@ def estimate_corrections(
     val = np.asarray(obs_values, dtype=np.float64)
     if val.ndim != 2 or len(val) != len(cell) or len(img) != len(cell):
         raise InputError("estimate_corrections: observations must be (K,), (K,) and (K, channels)")
+    ref = val if values_before is None else np.asarray(values_before, dtype=np.float64)
+    if ref.shape != val.shape:
+        raise InputError("estimate_corrections: values_before must be shaped like the observations")
     nch = val.shape[1]
     n = int(n_images)
     for name, v in (("max_pairs", max_pairs), ("per_pair", per_pair), ("budget", budget)):
@@ -552,7 +604,7 @@ def estimate_corrections(
         )
         gain[:, ch] = g
         offset[:, ch] = o
-        ra = (xa - xb) ** 2
+        ra = (ref[ii, ch] - ref[jj, ch]) ** 2
         rb = ((g[ia] * xa + o[ia]) - (g[ib] * xb + o[ib])) ** 2
         rms_before.append(float(np.sqrt(np.mean(ra))))
         rms_after.append(float(np.sqrt(np.mean(rb))))
@@ -564,6 +616,35 @@ def estimate_corrections(
     stats["median_before"] = [round(v, 4) for v in mad_before]
     stats["median_after"] = [round(v, 4) for v in mad_after]
     return ColorCorrection(gain, offset, uses_lab(nch), stats)
+
+
+def estimate_colour_model(obs_cell, obs_image, samples, n_images: int, dtype, **kwargs) -> ColorCorrection:
+    """Both stages of the model (module docstring) from multiply observed cells.
+
+    ``samples`` (K, bands) are the observations as stored (the data's units, vignetting already
+    removed). RGB data: gains and offsets per RGB channel first, then, on the samples they
+    corrected, L*a*b* gains and offsets (:func:`estimate_corrections` each, with ``kwargs``); other
+    data: the per-band stage alone. ``stats`` are the last stage's, with the disagreement before
+    both stages (``*_before``, L*a*b*), the first stage's under ``"rgb_stage"`` (data units).
+    """
+    cell = np.asarray(obs_cell, dtype=np.int64).reshape(-1)
+    img = np.asarray(obs_image, dtype=np.int64).reshape(-1)
+    raw = np.asarray(samples, dtype=np.float64)
+    if raw.ndim != 2 or len(raw) != len(cell):
+        raise InputError("estimate_colour_model: samples must be (K, bands) like the observations")
+    if not uses_lab(raw.shape[1]):
+        return estimate_corrections(cell, img, raw, n_images, **kwargs)
+    first = estimate_corrections(cell, img, raw[:, :3], n_images, **kwargs)
+    dt = np.dtype(dtype)
+    lo, hi = (np.iinfo(dt).min, np.iinfo(dt).max) if dt.kind in "ui" else (-np.inf, np.inf)
+    staged = raw.copy()
+    staged[:, :3] = np.clip(raw[:, :3] * first.gain[img] + first.offset[img], lo, hi)
+    corr = estimate_corrections(
+        cell, img, to_channels(staged, dtype), n_images, values_before=to_channels(raw, dtype), **kwargs
+    )
+    corr.rgb_gain, corr.rgb_offset = first.gain, first.offset
+    corr.stats["rgb_stage"] = first.stats
+    return corr
 
 
 def _group_ids(ids: np.ndarray, id_range: int):

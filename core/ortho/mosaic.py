@@ -408,6 +408,12 @@ def mosaic_tile(
     if correction is not None:
         for k, i in enumerate(views.cands):
             if not correction.is_identity(int(i)):
+                if correction.has_rgb_stage(int(i)) and store.bands >= 3:
+                    # the RGB stage's gains and offsets averaged with the luminance's weights
+                    assert correction.rgb_gain is not None and correction.rgb_offset is not None
+                    g1 = float(np.asarray(REC601) @ correction.rgb_gain[int(i)])
+                    o1 = float(np.asarray(REC601) @ correction.rgb_offset[int(i)])
+                    lum[k] = g1 * lum[k] + o1 / value_scale(store.dtype)
                 g, o = correction.gain[int(i), 0], correction.offset[int(i), 0]
                 lum[k] = g * lum[k] + (o / 100.0 if correction.lab else o / value_scale(store.dtype))
     local_fixed = None

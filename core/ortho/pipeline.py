@@ -49,10 +49,9 @@ from ..rasterio_io import COMPRESSIONS
 from .color import (
     ColorCorrection,
     devignette_values,
-    estimate_corrections,
+    estimate_colour_model,
     estimate_vignetting,
     linear_luminance,
-    to_channels,
 )
 from .mosaic import ImageStore, MosaicParams, candidate_colours, each
 from .seams import dissolve, region_polygons
@@ -976,6 +975,8 @@ def _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs) -> str
         d.add([np.asarray(correction.gain), np.asarray(correction.offset), bool(correction.lab)])
         if correction.vignetting is not None:
             d.add([np.asarray(correction.vignetting), np.asarray(correction.centre)])
+        if correction.rgb_gain is not None:
+            d.add([np.asarray(correction.rgb_gain), np.asarray(correction.rgb_offset)])
     return d.hexdigest()
 
 
@@ -1050,7 +1051,7 @@ def _estimate_colour(
             raw = devignette_values(raw, factor, store.dtype)
         else:
             vig = None
-    corr = estimate_corrections(cell, img, to_channels(raw, store.dtype), n_images)
+    corr = estimate_colour_model(cell, img, raw, n_images, store.dtype)
     corr.stats["grid_factor"] = f
     if cfg.vignetting:
         corr.stats["vignetting"] = vstats

@@ -286,9 +286,10 @@ HELP: dict[str, dict] = {
             "cell the one with the finest effective ground resolution (distance and incidence on the "
             "surface) is preferred; roofs are textured from one image each and seamlines follow height "
             "discontinuities and avoid places where the images disagree (label smoothing), with feathering "
-            "across seams only between images that both see the cells. Per-image colour corrections in "
-            "CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells "
-            "seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. "
+            "across seams only between images that both see the cells. Per-image colour corrections (a "
+            "gain/offset per RGB channel for white balance and exposure, then one in CIE L*a*b*; per-band "
+            "gain/offset for non-RGB data) are estimated by least squares from cells seen by several "
+            "images. Cells no image sees get alpha 0 and appear in the occlusion mask. "
             "Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). "
             "Processing runs by tiles with bounded memory; progress and cancel per tile."
         ),

@@ -8,6 +8,7 @@ import pytest
 from truortho.core.ortho.color import (
     ColorCorrection,
     devignette_values,
+    estimate_colour_model,
     estimate_corrections,
     estimate_vignetting,
     from_channels,
@@ -64,6 +65,61 @@ def test_apply_keeps_the_range_of_the_dtype():
     assert ColorCorrection.identity(2, 1).apply(1, s[:, :1], "float32") is not None
 
 
+def _white_balanced_block(rng, n_img=6, n_cell=3000):
+    """Cells of sRGB colours over the whole lightness range, seen by 2-4 images each; every image
+    scales and shifts each channel of the stored values (white balance, exposure, black level)."""
+    g = 1.0 + rng.normal(0, 0.06, (n_img, 1)) + rng.normal(0, 0.03, (n_img, 3))
+    o = rng.normal(0, 0.015, (n_img, 3))
+    truth = rng.uniform(0.05, 0.85, (n_cell, 3))
+    cells, imgs, vals = [], [], []
+    for c in range(n_cell):
+        for i in rng.choice(n_img, size=rng.integers(2, 5), replace=False):
+            cells.append(c)
+            imgs.append(i)
+            vals.append(np.clip(np.round(255 * (truth[c] * g[i] + o[i]) + rng.normal(0, 1.0, 3)), 0, 255))
+    # the exact inverse, as a first stage
+    exact = ColorCorrection.identity(n_img, 3)
+    exact.rgb_gain, exact.rgb_offset = 1.0 / g, -255.0 * o / g
+    return np.array(cells), np.array(imgs), np.array(vals, float), exact
+
+
+def _disagreement(corr, cells, imgs, vals) -> float:
+    """Mean dE between the corrected observations of the same cell (consecutive pairs)."""
+    out = np.empty_like(vals)
+    for i in np.unique(imgs):
+        out[imgs == i] = corr.apply(int(i), vals[imgs == i], "uint8")
+    same = np.flatnonzero(cells[1:] == cells[:-1])
+    lab = rgb_to_lab(out / 255.0)
+    return float(np.linalg.norm(lab[same] - lab[same + 1], axis=1).mean())
+
+
+def test_colour_model_undoes_a_white_balance_that_lab_alone_cannot():
+    """A gain per RGB channel moves a* and b* by an amount that grows with the lightness: L*a*b*
+    gains and offsets leave part of it between images; the first stage per RGB channel removes it."""
+    rng = np.random.default_rng(5)
+    cells, imgs, vals, exact = _white_balanced_block(rng)
+    lab_only = estimate_corrections(cells, imgs, to_channels(vals, "uint8"), 6)
+    both = estimate_colour_model(cells, imgs, vals, 6, "uint8")
+    before = _disagreement(ColorCorrection.identity(6, 3), cells, imgs, vals)
+    d_lab, d_both = _disagreement(lab_only, cells, imgs, vals), _disagreement(both, cells, imgs, vals)
+    # what the observation noise (1 DN per channel) leaves between two images
+    floor = _disagreement(exact, cells, imgs, vals)
+    assert d_both < 1.1 * floor < 1.4 * floor < d_lab < 0.5 * before, (before, floor, d_lab, d_both)
+    assert both.rgb_gain is not None and both.rgb_offset is not None
+    assert np.allclose(both.rgb_gain.mean(axis=0), 1.0, atol=1e-3)
+    # the statistics compare the samples before both stages with those after them
+    assert both.stats["median_after"][0] < 0.3 * both.stats["median_before"][0], both.stats
+    # the second stage has little left to do
+    assert np.abs(both.gain - 1.0).max() < 0.05 and np.abs(both.offset).max() < 1.0
+    d = both.as_dict()
+    assert d["model"].startswith("per-channel RGB") and len(d["images"][0]["rgb_gain"]) == 3
+    # non-RGB data: one stage per band, as before
+    single = estimate_colour_model(cells, imgs, vals[:, :1], 6, "uint8")
+    assert single.rgb_gain is None and not single.lab
+    with pytest.raises(Exception, match="samples"):
+        estimate_colour_model(cells, imgs, vals[:10], 6, "uint8")
+
+
 def test_weakly_correlated_samples_do_not_shrink_the_gains():
     """Fine cells on fine imagery: the samples of one cell differ between images as much as cells differ.
 
@@ -112,6 +168,11 @@ def test_apply_inplace_equals_apply():
         c = ColorCorrection.identity(3, bands)
         c.gain[1] = rng.uniform(0.8, 1.2, bands)
         c.offset[1] = rng.uniform(-5, 5, bands)
+        if bands in (3, 4):  # with the first stage per RGB channel (in the data's units)
+            c.rgb_gain, c.rgb_offset = np.ones((3, 3)), np.zeros((3, 3))
+            scale0 = {"uint8": 255.0, "uint16": 65535.0}.get(dt, 1.0)
+            c.rgb_gain[1] = rng.uniform(0.9, 1.1, 3)
+            c.rgb_offset[1] = rng.uniform(-0.02, 0.02, 3) * scale0
         scale = {"uint8": 255.0, "uint16": 65535.0}.get(dt, 1.0)
         s = (rng.uniform(0, 1, (30, 20, bands)) * scale).astype(np.float32)
         m = rng.uniform(size=(30, 20)) > 0.3
