@@ -9,7 +9,7 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ENV := source scripts/env.sh &&
 
-.PHONY: setup test lint pytest demo bench acceptance acceptance-ablation acceptance-real acceptance-fountain zip docs
+.PHONY: setup test lint pytest demo bench acceptance acceptance-ablation acceptance-real acceptance-fountain acceptance-colours zip docs
 
 setup:
 	bash scripts/setup.sh
@@ -52,6 +52,11 @@ acceptance: setup
 # JPEG, noise and radiometric jitter (ACCEPTANCE_ARGS as above; about 10 minutes).
 acceptance-ablation: setup
 	$(ENV) $(PY) -P bench/acceptance_ablation.py $(ACCEPTANCE_ARGS)
+
+# Colour models on held-out cells of the battery's scenes and of real blocks kept by a real-blocks run:
+# make acceptance-colours COLOUR_ARGS="--real sample=DIR/sample/products --write-docs"
+acceptance-colours: setup
+	$(ENV) $(PY) -P bench/colour_models.py $(COLOUR_ARGS)
 
 # Real photo blocks through the whole pipeline (no truth DSM): make acceptance-real REAL_ARGS="--blocks sample,brighton"
 acceptance-real: setup

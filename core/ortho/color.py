@@ -618,7 +618,9 @@ def estimate_corrections(
     return ColorCorrection(gain, offset, uses_lab(nch), stats)
 
 
-def estimate_colour_model(obs_cell, obs_image, samples, n_images: int, dtype, **kwargs) -> ColorCorrection:
+def estimate_colour_model(
+    obs_cell, obs_image, samples, n_images: int, dtype, rgb_stage: bool = True, **kwargs
+) -> ColorCorrection:
     """Both stages of the model (module docstring) from multiply observed cells.
 
     ``samples`` (K, bands) are the observations as stored (the data's units, vignetting already
@@ -626,6 +628,8 @@ def estimate_colour_model(obs_cell, obs_image, samples, n_images: int, dtype, **
     corrected, L*a*b* gains and offsets (:func:`estimate_corrections` each, with ``kwargs``); other
     data: the per-band stage alone. ``stats`` are the last stage's, with the disagreement before
     both stages (``*_before``, L*a*b*), the first stage's under ``"rgb_stage"`` (data units).
+    ``rgb_stage=False``: the L*a*b* stage alone (the model before the RGB stage; for comparisons,
+    ``bench/colour_models.py``).
     """
     cell = np.asarray(obs_cell, dtype=np.int64).reshape(-1)
     img = np.asarray(obs_image, dtype=np.int64).reshape(-1)
@@ -634,6 +638,8 @@ def estimate_colour_model(obs_cell, obs_image, samples, n_images: int, dtype, **
         raise InputError("estimate_colour_model: samples must be (K, bands) like the observations")
     if not uses_lab(raw.shape[1]):
         return estimate_corrections(cell, img, raw, n_images, **kwargs)
+    if not rgb_stage:
+        return estimate_corrections(cell, img, to_channels(raw, dtype), n_images, **kwargs)
     first = estimate_corrections(cell, img, raw[:, :3], n_images, **kwargs)
     dt = np.dtype(dtype)
     lo, hi = (np.iinfo(dt).min, np.iinfo(dt).max) if dt.kind in "ui" else (-np.inf, np.inf)

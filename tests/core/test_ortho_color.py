@@ -98,7 +98,8 @@ def test_colour_model_undoes_a_white_balance_that_lab_alone_cannot():
     gains and offsets leave part of it between images; the first stage per RGB channel removes it."""
     rng = np.random.default_rng(5)
     cells, imgs, vals, exact = _white_balanced_block(rng)
-    lab_only = estimate_corrections(cells, imgs, to_channels(vals, "uint8"), 6)
+    lab_only = estimate_colour_model(cells, imgs, vals, 6, "uint8", rgb_stage=False)
+    assert lab_only.rgb_gain is None and lab_only.lab
     both = estimate_colour_model(cells, imgs, vals, 6, "uint8")
     before = _disagreement(ColorCorrection.identity(6, 3), cells, imgs, vals)
     d_lab, d_both = _disagreement(lab_only, cells, imgs, vals), _disagreement(both, cells, imgs, vals)
