@@ -30,16 +30,25 @@ ROOT = os.path.dirname(HERE)
 DOCS = os.path.join(ROOT, "docs", "benchmarks.md")
 
 
+#: What the benches write (docs sections, pictures): a change there is not a change of the code measured,
+#: so it does not make a run "+dirty" (one docs-writing bench after another, before a commit).
+WRITTEN_BY_BENCHES = ("docs", "bench/results")
+
+
 def commit() -> str:
-    """Short hash of HEAD (``+dirty`` when the working tree differs), or ``unknown``."""
+    """Short hash of HEAD (``+dirty`` when the working tree differs outside
+    :data:`WRITTEN_BY_BENCHES`), or ``unknown``."""
     try:
         git = ["git", "-C", ROOT]
         rev = subprocess.run([*git, "rev-parse", "--short", "HEAD"], capture_output=True, text=True)
         if rev.returncode != 0:
             return "unknown"
         dirty = subprocess.run(
-            [*git, "status", "--porcelain", "--untracked-files=no"], capture_output=True, text=True
-        )
+            [*git, "status", "--porcelain", "--untracked-files=no", "--", ".",
+             *(f":(exclude){p}" for p in WRITTEN_BY_BENCHES)],
+            capture_output=True,
+            text=True,
+        )  # fmt: skip
         return rev.stdout.strip() + ("+dirty" if dirty.stdout.strip() else "")
     except OSError:
         return "unknown"
