@@ -124,7 +124,9 @@ class Report:
 
 
 #: Tables :func:`pipeline_report` adds after the orientation's (they belong to one run of the chain).
-_CHAIN_TABLES = ("Dense matching and DSM filter", "Stages")
+#: The tables of the chain after the orientation (a reused orientation's report drops them); the
+#: stage table comes last (the workflow fills it in).
+_CHAIN_TABLES = ("Dense matching and DSM filter", "Colour correction", "Stages")
 
 
 def reused_orientation_report(json_path: str | os.PathLike) -> Report | None:
@@ -258,8 +260,40 @@ def pipeline_report(
     ax.ticklabel_format(useOffset=False, style="plain")
     ax.set_title(f"True orthophoto (black: seen by no image, {100 * occl:.2f} %)")
     report.add_figure("True orthophoto preview", fig)
-    report.tables.append(Table(_CHAIN_TABLES[1], ["stage", "time [s]", "peak memory [MB]", "result"], []))
+    cc = tres.stats.get("color_correction")
+    if isinstance(cc, dict) and cc.get("images"):
+        report.data["trueortho"]["color_correction"] = cc
+        report.tables.append(colour_table(cc))
+        before, after = cc.get("median_before"), cc.get("median_after")
+        if before and after:
+            report.summary["true ortho colour disagreement between photos (median, before -> after)"] = (
+                f"{before[0]:.2f} -> {after[0]:.2f} ({'L*' if 'L*a*b*' in cc.get('model', '') else 'band 1'})"
+            )
+    report.tables.append(Table(_CHAIN_TABLES[-1], ["stage", "time [s]", "peak memory [MB]", "result"], []))
     return report
+
+
+def colour_table(cc: dict) -> Table:
+    """The true ortho's colour correction per photo (:meth:`ColorCorrection.as_dict`): vignetting at
+    the corner, the RGB stage's gains and offsets (data units) and the L*a*b* (or per-band) ones."""
+    lab = "L*a*b*" in str(cc.get("model", ""))
+    rgb = any("rgb_gain" in r for r in cc["images"])
+    columns = ["photo", "vignetting at the corner"]
+    if rgb:
+        columns += ["gain R / G / B", "offset R / G / B"]
+    columns += ["gain L* / a* / b*", "offset L* / a* / b*"] if lab else ["gain per band", "offset per band"]
+
+    def values(v) -> str:
+        return " / ".join(f"{float(x):.3f}" for x in v)
+
+    rows = []
+    for r in cc["images"]:
+        row = [r["image"], float(r.get("vignetting_at_corner", 1.0))]
+        if rgb:
+            row += [values(r.get("rgb_gain", [])), values(r.get("rgb_offset", []))]
+        rows.append(row + [values(r["gain"]), values(r["offset"])])
+    note = f"Model: {cc.get('model', '?')}; estimated from {cc.get('pairs_used', '?')} pairs of observations."
+    return Table(_CHAIN_TABLES[1], columns, rows, note)
 
 
 def photo_counts(orientation, dsm, grid) -> np.ndarray:

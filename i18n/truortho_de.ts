@@ -1069,6 +1069,11 @@
             <translation>JPEG (verlustbehaftet, nur 8-Bit-RGB-Bilder; Alpha wird zur Maske)</translation>
         </message>
         <message>
+            <location filename="../processing/algorithms/trueortho.py" line="247" />
+            <source>colour correction ({}): disagreement between photos, median {:.2f} -&gt; {:.2f}</source>
+            <translation>Farbkorrektur ({}): Abweichung zwischen den Fotos, Median {:.2f} -&gt; {:.2f}</translation>
+        </message>
+        <message>
             <location filename="../processing/feedback.py" line="86" />
             <source>Cancelled by the user</source>
             <translation>Vom Benutzer abgebrochen</translation>

@@ -1069,6 +1069,11 @@
             <translation>JPEG (avec perte, images RVB 8 bits seulement ; l'alpha devient un masque)</translation>
         </message>
         <message>
+            <location filename="../processing/algorithms/trueortho.py" line="247" />
+            <source>colour correction ({}): disagreement between photos, median {:.2f} -&gt; {:.2f}</source>
+            <translation>correction colorimétrique ({}) : écart entre les photos, médiane {:.2f} -&gt; {:.2f}</translation>
+        </message>
+        <message>
             <location filename="../processing/feedback.py" line="86" />
             <source>Cancelled by the user</source>
             <translation>Annulé par l'utilisateur</translation>

@@ -241,6 +241,13 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
                 st["rows"], st["cols"], st["images_used"], st["coverage"], st["cells_occluded"]
             )
         )
+        cc = st.get("color_correction")
+        if isinstance(cc, dict) and cc.get("median_before") and cc.get("median_after"):
+            feedback.pushInfo(
+                tr("colour correction ({}): disagreement between photos, median {:.2f} -> {:.2f}").format(
+                    cc.get("model", ""), cc["median_before"][0], cc["median_after"][0]
+                )
+            )
         results = {self.OUTPUT: out}
         if idx:
             results[self.SOURCE_INDEX] = idx

@@ -52,6 +52,14 @@ def test_workflow_products_and_report_from_a_reused_orientation(tmp_path):
         "orientation", "dense matching (OSGM)", "DSM filter", "mesh", "true orthophoto",
     ]  # fmt: skip
     assert all(s[1] >= 0 and s[2] > 0 for s in stages)
+    # the colour correction per photo (the scene's photos differ in exposure and white balance)
+    colour = [t for t in rep["tables"] if t["title"] == "Colour correction"][0]
+    assert len(colour["rows"]) == len(o.images) and colour["columns"][2] == "gain R / G / B"
+    gains = np.array([[float(v) for v in row[2].split(" / ")] for row in colour["rows"]])
+    assert np.allclose(gains.mean(axis=0), 1.0, atol=0.01) and gains.std() > 0.01
+    cc = rep["data"]["trueortho"]["color_correction"]
+    assert cc["median_after"][0] < cc["median_before"][0]
+    assert "colour disagreement" in " ".join(rep["summary"])
     html = (out / "report.html").read_text()
     assert html.count("data:image/png;base64,") >= 2  # offline: images embedded, nothing linked
     assert "src='http" not in html and 'src="http' not in html and "<link" not in html

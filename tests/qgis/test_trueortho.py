@@ -20,10 +20,10 @@ def scene_dir(tmp_path_factory):
     return scene, root
 
 
-def run(params):
+def run(params, feedback=None):
     import processing
 
-    return processing.run("truortho:trueortho", params)
+    return processing.run("truortho:trueortho", params, feedback=feedback)
 
 
 def test_trueortho_executor_parameters(truortho_provider):
@@ -50,6 +50,18 @@ def test_trueortho_outputs(truortho_provider, scene_dir, tmp_path):
 
     from truortho.core.rasterio_io import read_raster
 
+    from qgis.core import QgsProcessingFeedback
+
+    class Recording(QgsProcessingFeedback):
+        def __init__(self):
+            super().__init__()
+            self.infos: list[str] = []
+
+        def pushInfo(self, info):  # noqa: N802 - QGIS API
+            self.infos.append(info)
+            super().pushInfo(info)
+
+    fb = Recording()
     scene, root = scene_dir
     res = run(
         {
@@ -61,8 +73,14 @@ def test_trueortho_outputs(truortho_provider, scene_dir, tmp_path):
             "SOURCE_INDEX": str(tmp_path / "idx.tif"),
             "OCCLUSION": str(tmp_path / "occ.tif"),
             "SEAMLINES": str(tmp_path / "seams.gpkg"),
-        }
+        },
+        fb,
     )
+    # the log tells what the colour correction did (the scene's photos differ in exposure)
+    told = [t for t in fb.infos if t.startswith("colour correction (per-channel RGB")]
+    assert len(told) == 1, fb.infos
+    before, after = (float(v) for v in told[0].rsplit("median ", 1)[1].split(" -> "))
+    assert after < before
     ortho = QgsRasterLayer(res["OUTPUT"], "o")
     assert ortho.isValid() and ortho.bandCount() == 4 and ortho.crs().authid() == "EPSG:32632"
     idx, _, _ = read_raster(res["SOURCE_INDEX"])
