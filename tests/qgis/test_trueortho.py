@@ -46,11 +46,9 @@ def test_trueortho_executor_parameters(truortho_provider):
 
 
 def test_trueortho_outputs(truortho_provider, scene_dir, tmp_path):
-    from qgis.core import QgsRasterLayer, QgsVectorLayer
+    from qgis.core import QgsProcessingFeedback, QgsRasterLayer, QgsVectorLayer
 
     from truortho.core.rasterio_io import read_raster
-
-    from qgis.core import QgsProcessingFeedback
 
     class Recording(QgsProcessingFeedback):
         def __init__(self):
