@@ -226,42 +226,18 @@ class ColorCorrection:
                 _LUT_N,
                 _LUT_TOP,
             )
+        flat = colours.reshape(-1, colours.shape[-1])
+        m = np.ascontiguousarray(mask).reshape(-1)
+
+        def stage(gain, offset, lab: bool) -> None:
+            g, o = np.ascontiguousarray(gain, np.float64), np.ascontiguousarray(offset, np.float64)
+            _correct(flat, m, g, o, lab, value_scale(dt), lo, hi, _M, _M_INV, _WHITE, _LUTS, _LUT_N, _LUT_TOP)
+
         if self.has_rgb_stage(i) and uses_lab(colours.shape[-1]):
-            g, o = self._rgb_stage(i, colours.shape[-1])
-            _correct(
-                colours.reshape(-1, colours.shape[-1]),
-                np.ascontiguousarray(mask).reshape(-1),
-                g,
-                o,
-                False,
-                value_scale(dt),
-                lo,
-                hi,
-                _M,
-                _M_INV,
-                _WHITE,
-                _LUTS,
-                _LUT_N,
-                _LUT_TOP,
-            )
+            stage(*self._rgb_stage(i, colours.shape[-1]), False)
         if np.all(self.gain[i] == 1.0) and np.all(self.offset[i] == 0.0):
             return
-        _correct(
-            colours.reshape(-1, colours.shape[-1]),
-            np.ascontiguousarray(mask).reshape(-1),
-            np.ascontiguousarray(self.gain[i], np.float64),
-            np.ascontiguousarray(self.offset[i], np.float64),
-            bool(self.lab and uses_lab(colours.shape[-1])),
-            value_scale(dt),
-            lo,
-            hi,
-            _M,
-            _M_INV,
-            _WHITE,
-            _LUTS,
-            _LUT_N,
-            _LUT_TOP,
-        )
+        stage(self.gain[i], self.offset[i], bool(self.lab and uses_lab(colours.shape[-1])))
 
     def as_dict(self, names: list[str] | None = None) -> dict:
         rows: list[dict] = []
