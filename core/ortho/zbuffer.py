@@ -763,9 +763,9 @@ def _frame_pass(
 
 
 @njit
-def _near_field_hidden(n, P, hloc, cols, res, C, tol_h):
-    """Whether the cell ``n``'s own ray towards ``C`` enters one of the cells of the 5 x 5
-    neighbourhood below that cell's top by more than ``tol_h`` (metres).
+def _near_field_hidden(n, P, hloc, cols, res, C, tol_h, reach):
+    """Whether the cell ``n``'s own ray towards ``C`` enters one of the cells within ``reach`` cells
+    (the ``2 reach + 1`` square neighbourhood) below that cell's top by more than ``tol_h`` (metres).
 
     The exact raster geometry next to the point, which the depth buffer cannot resolve: an
     occluder whose depth lies within the depth tolerance (a wall a fraction of a cell away, the
@@ -789,8 +789,8 @@ def _near_field_hidden(n, P, hloc, cols, res, C, tol_h):
     ux = dx / dh
     uy = dy / dh
     half = 0.5 * res
-    for rr in range(max(r - 2, 0), min(r + 3, rows)):
-        for cc in range(max(c - 2, 0), min(c + 3, cols)):
+    for rr in range(max(r - reach, 0), min(r + reach + 1, rows)):
+        for cc in range(max(c - reach, 0), min(c + reach + 1, cols)):
             m = rr * cols + cc
             hm = hloc[m]
             if m == n or not (hm > z0 + tol_h):
@@ -846,6 +846,7 @@ def _view_pass(
     hloc,
     near_step,
     cols,
+    reach,
     hnoise,
     usable,
     edge,
@@ -862,7 +863,7 @@ def _view_pass(
     Tolerance as :func:`depth_tolerance`, plus ``hnoise / cos(view angle)`` (the surface's own
     height noise, :func:`height_noise`). Where ``near_step`` is set (cells of a ``cols``-wide grid,
     heights ``hloc``, NaN = none), a cell that passes the depth test is still hidden when its ray
-    enters a neighbouring cell below that cell's top (:func:`_near_field_hidden`).
+    enters a cell within ``reach`` cells below that cell's top (:func:`_near_field_hidden`).
     """
     H = zbuf.shape[0]
     W = zbuf.shape[1]
@@ -900,7 +901,7 @@ def _view_pass(
             near = zmin < z - t
             # next to a much higher cell, the exact raster geometry decides with the same tolerance
             # (the buffer's pixels cannot: the ray past a corner, an occluder within the tolerance)
-            if near_step[n] and _near_field_hidden(n, P, hloc, cols, res, C, t):
+            if near_step[n] and _near_field_hidden(n, P, hloc, cols, res, C, t, reach):
                 continue
         if moved[n]:
             su, sv, sz = _proj(S[n, 0], S[n, 1], S[n, 2], R, C, p_full, r2max)
@@ -1009,12 +1010,12 @@ def view_cells_into(
         front): near an occlusion edge, full-resolution sample coordinates (rounded to the pixel
         centre next to an occluder), effective ground resolution ``distance / (fx cos incidence)``.
 
-    near_field : (heights (N,) float64, near_step (N,) bool, cols), optional
+    near_field : (heights (N,) float64, near_step (N,) bool, cols[, reach]), optional
         With the depth test: the points are the cells of a grid ``cols`` wide, row-major, with their
-        heights (local z, NaN = no data); where ``near_step`` is set (a much higher cell within two
-        cells, :func:`near_step_mask`), a cell visible in the buffer is still hidden when its ray
-        towards the camera enters a neighbouring cell below that cell's top by more than the
-        depth tolerance. The depth buffer cannot see such occluders: their
+        heights (local z, NaN = no data); where ``near_step`` is set (a much higher cell within
+        ``reach`` cells, default 2, :func:`near_step_mask`), a cell visible in the buffer is still
+        hidden when its ray towards the camera enters a cell within ``reach`` cells below that
+        cell's top by more than the depth tolerance. The depth buffer cannot see such occluders: their
         depth lies within the tolerance, or between two buffer pixel centres (a ground cell
         diagonally next to a building's corner, seen past the corner).
     noise : (N,) float64, optional
@@ -1044,20 +1045,28 @@ def view_cells_into(
     if zbuf is None:
         zbuf = np.full((1, 1), np.inf, np.float32)
         window = (0, 0, 1, 1)
+    reach = 2
     if near_field is None:
         hloc, near_step, cols = np.zeros(0), np.zeros(n, np.bool_), 1
     else:
-        hloc, near_step, cols = near_field
+        hloc, near_step, cols = near_field[:3]
         cols = int(cols)
+        if len(near_field) > 3:
+            reach = near_field[3]
         if (
             np.shape(hloc) != (n,)
             or np.shape(near_step) != (n,)
             or near_step.dtype != np.bool_
             or cols < 1
             or n % cols
+            or len(near_field) > 4
+            or isinstance(reach, bool)
+            or not isinstance(reach, int | np.integer)
+            or reach < 1
         ):
             raise InputError(
-                "view_cells_into: near_field must be (N,) heights, (N,) bool and the grid's columns"
+                "view_cells_into: near_field must be (N,) heights, (N,) bool, the grid's columns and "
+                "optionally the reach in cells (an integer >= 1)"
             )
         hloc = np.ascontiguousarray(hloc, np.float64)
     if noise is None:
@@ -1094,6 +1103,7 @@ def view_cells_into(
             hloc,
             near_step,
             cols,
+            int(reach),
             hnoise,
             usable,
             edge,
@@ -1103,9 +1113,10 @@ def view_cells_into(
     )
 
 
-def near_step_mask(heights: np.ndarray, res: float, step_cells: float = 2.0) -> np.ndarray:
-    """Cells (rows, cols) with a cell more than ``step_cells`` cell sizes higher within two cells:
-    where :func:`view_cells_into`'s near-field test runs (elsewhere the depth test is enough)."""
+def near_step_mask(heights: np.ndarray, res: float, step_cells: float = 2.0, reach: int = 2) -> np.ndarray:
+    """Cells (rows, cols) with a cell more than ``step_cells`` cell sizes higher within ``reach``
+    cells: where :func:`view_cells_into`'s near-field test runs (elsewhere the depth test is
+    enough)."""
     from scipy.ndimage import maximum_filter
 
     h = np.asarray(heights, dtype=np.float64)
@@ -1114,8 +1125,10 @@ def near_step_mask(heights: np.ndarray, res: float, step_cells: float = 2.0) -> 
     for name, v in (("res", res), ("step_cells", step_cells)):
         if isinstance(v, bool) or not (math.isfinite(float(v)) and float(v) > 0):
             raise InputError(f"near_step_mask: {name} must be a finite number > 0, got {v!r}")
+    if isinstance(reach, bool) or not isinstance(reach, int | np.integer) or reach < 1:
+        raise InputError(f"near_step_mask: reach must be an integer >= 1, got {reach!r}")
     hz = np.where(np.isfinite(h), h, -np.inf)
-    top = maximum_filter(hz, size=5, mode="constant", cval=-np.inf)
+    top = maximum_filter(hz, size=2 * int(reach) + 1, mode="constant", cval=-np.inf)
     with np.errstate(invalid="ignore"):
         return np.isfinite(h) & (top - h > float(step_cells) * float(res))
 

@@ -240,7 +240,7 @@ def test_concurrent_resampled_dsm_reads_equal_serial_reads(tmp_path):
     assert not bad
 
 
-def _near_field_views(h, res, C, near_field: bool):
+def _near_field_views(h, res, C, near_field: bool, noise=None, reach=None):
     """``view_cells_into`` of every cell of the grid ``h`` (cell (0, 0) centred at (res/2, -res/2))
     for a camera at ``C`` looking at the grid's centre, against an empty depth buffer (the depth
     test passes everywhere): only the near-field test can hide a cell."""
@@ -258,9 +258,13 @@ def _near_field_views(h, res, C, near_field: bool):
     normals /= np.linalg.norm(normals, axis=1)[:, None]
     out = (np.zeros(n, bool), np.zeros(n, bool), np.zeros((n, 2), np.float32), np.zeros(n, np.float32))
     zbuf = np.full((400, 400), np.inf, np.float32)
-    nf = (h.ravel().astype(float), near_step_mask(h, res).ravel(), cols) if near_field else None
+    nf = None
+    if near_field:
+        nf = (h.ravel().astype(float), near_step_mask(h, res).ravel(), cols)
+        if reach is not None:
+            nf = (h.ravel().astype(float), near_step_mask(h, res, reach=reach).ravel(), cols, reach)
     view_cells_into(fc, P, P, np.zeros(n, bool), normals, R, C, cam, zbuf, (0, 0, 400, 400), 1.0, res, out,
-                    near_field=nf)  # fmt: skip
+                    near_field=nf, noise=noise)  # fmt: skip
     return out[0].reshape(rows, cols)
 
 
@@ -282,6 +286,33 @@ def test_near_field_hides_a_cell_seen_past_a_building_corner():
     assert with_nf[0:3, 0:3].all() and with_nf[0:3, 8:].all()
     assert (with_nf[6:, 6:] == without[6:, 6:]).all() and with_nf[7:, 7:].all()
     assert (with_nf <= without).all()  # the test only ever hides
+
+
+def test_near_field_reaches_as_far_as_the_noise_tolerance():
+    """A ground cell 3 cells behind a 10 m building, its ray to an oblique camera through the
+    building (entering its wall 0.29 m up, 0.38 m along the ray): where the depth buffer misses the
+    building's far side, the noise term of the tolerance (0.3 m here) lets the depth test pass, and
+    a near field of two cells does not reach the wall; one that reaches as far as the tolerance
+    (:func:`near_field_reach`) hides the cell (seed 7's scene 3 textured such cells with the roof)."""
+    from truortho.core.ortho.views import NEAR_FIELD_MAX, near_field_reach
+
+    res = 0.1
+    h = np.zeros((7, 14))
+    h[:, 10:] = 10.0  # a building east of the wall at x = 1.0
+    theta = np.radians(41.0)
+    C = np.array([0.75 + 120.0 * np.sin(theta), -0.35, 120.0 * np.cos(theta)])  # east, 41 degrees off nadir
+    n = h.size
+    noise = np.full(n, 2.0 * np.sqrt(2.0) * 0.08)  # sigma 8 cm, as next to that wall
+    reach = near_field_reach(noise, np.radians(45.0), res)
+    assert reach == 2 + 4 and near_field_reach(None, np.radians(45.0), res) == 2
+    assert near_field_reach(np.full(3, 100.0), np.radians(45.0), res) == NEAR_FIELD_MAX
+    short = _near_field_views(h, res, C, near_field=True, noise=noise)
+    far = _near_field_views(h, res, C, near_field=True, noise=noise, reach=reach)
+    assert short[3, 7] and not far[3, 7]  # the cell 3 cells west of the wall
+    assert not far[:, 4:10].any()  # every ground cell within the reach: hidden (the empty buffer alone
+    assert short[:, :8].all()  # shows all of them; the short near field hides the two next to the wall)
+    assert far[:, 11:].all() and (far[:, 10:] == short[:, 10:]).all()  # the roof is left alone
+    assert (far <= short).all()
 
 
 def test_near_field_keeps_a_steep_slope_facing_the_camera():
