@@ -49,21 +49,21 @@ NOISE_REACH = 9 // 2 + 3
 #: depth tolerance without the noise term; the noise term adds cells up to this bound).
 NEAR_FIELD_MAX = 8
 
-def near_field_reach(noise: np.ndarray | None, max_view: float, res: float) -> int:
-    """Cells the near-field test of :func:`~.zbuffer.view_cells_into` must reach for a tile whose
-    cells have the height tolerances ``noise`` (metres, the noise term; None = none).
+def near_field_reach(noise, max_view: float, res: float) -> np.ndarray:
+    """Cells (int64, shaped like ``noise``) the near-field test of :func:`~.zbuffer.view_cells_into`
+    must reach for cells with the height tolerances ``noise`` (metres, the noise term).
 
-    Two cells cover the depth tolerance without the noise term. The noise term lengthens the
-    tolerance by up to ``noise / cos(max_view)`` along a ray, so a wall entered that far from the
+    Two cells cover the depth tolerance without the noise term. The noise term lengthens a cell's
+    tolerance by up to ``noise / cos(max_view)`` along its ray, so a wall entered that far from the
     cell passes the depth test: the near field must reach as far, or a ray through the wall's
     building hides nothing where the depth buffer misses the building's far side (seed 7's scene 3:
     ground cells 3 cells behind a building, seen through it from an oblique view past a sloped
     roof's omitted risers, where the noise estimate next to the wall read 8 cm). At most
-    :data:`NEAR_FIELD_MAX`.
+    :data:`NEAR_FIELD_MAX`. Per cell, so the result does not depend on the tiling.
     """
-    top = float(np.max(noise)) if noise is not None and len(noise) else 0.0
-    extra = int(math.ceil(top / (math.cos(max_view) * res))) if top > 0 else 0
-    return 2 + min(extra, NEAR_FIELD_MAX - 2)
+    a = np.asarray(noise, dtype=np.float64)
+    extra = np.ceil(np.nan_to_num(a, nan=0.0) / (math.cos(max_view) * res))
+    return (2 + np.clip(extra, 0, NEAR_FIELD_MAX - 2)).astype(np.int64)
 
 
 #: Candidates evaluated between two checks of the cells' clean views (``views_per_cell``).
@@ -503,7 +503,7 @@ def all_tile_views(
     near_field = None
     noise = None
     if setup.visibility:
-        reach = 2
+        reach = np.full(rows * cols, 2, np.int64)
         if setup.noise_tolerance > 0:
             # a rough matched surface (low-texture fields, canopies) hides its own cells from
             # oblique views behind its noise: bumps within the noise level do not occlude (computed
@@ -513,8 +513,8 @@ def all_tile_views(
             sig = height_noise(hreg[M - k : M + rows + k, M - k : M + cols + k])[k : k + rows, k : k + cols]
             noise = np.ascontiguousarray((setup.noise_tolerance * math.sqrt(2.0) * sig).ravel())
             reach = near_field_reach(noise, setup.max_view, res)
-        near_field = (np.where(valid, lz, np.nan).ravel(), near_step_mask(h, res, reach=reach).ravel(), cols,
-                      reach)  # fmt: skip
+        step = near_step_mask(h, res, reach=reach.reshape(h.shape)).ravel()
+        near_field = (np.where(valid, lz, np.nan).ravel(), step, cols, reach)
     # colour sample points: cells next to a height discontinuity are sampled a little inside their own
     # side, so the bilinear sample does not mix in the other side of a building outline
     S = P

@@ -863,7 +863,7 @@ def _view_pass(
     Tolerance as :func:`depth_tolerance`, plus ``hnoise / cos(view angle)`` (the surface's own
     height noise, :func:`height_noise`). Where ``near_step`` is set (cells of a ``cols``-wide grid,
     heights ``hloc``, NaN = none), a cell that passes the depth test is still hidden when its ray
-    enters a cell within ``reach`` cells below that cell's top (:func:`_near_field_hidden`).
+    enters a cell within ``reach[n]`` cells below that cell's top (:func:`_near_field_hidden`).
     """
     H = zbuf.shape[0]
     W = zbuf.shape[1]
@@ -901,7 +901,7 @@ def _view_pass(
             near = zmin < z - t
             # next to a much higher cell, the exact raster geometry decides with the same tolerance
             # (the buffer's pixels cannot: the ray past a corner, an occluder within the tolerance)
-            if near_step[n] and _near_field_hidden(n, P, hloc, cols, res, C, t, reach):
+            if near_step[n] and _near_field_hidden(n, P, hloc, cols, res, C, t, reach[n]):
                 continue
         if moved[n]:
             su, sv, sz = _proj(S[n, 0], S[n, 1], S[n, 2], R, C, p_full, r2max)
@@ -1012,10 +1012,11 @@ def view_cells_into(
 
     near_field : (heights (N,) float64, near_step (N,) bool, cols[, reach]), optional
         With the depth test: the points are the cells of a grid ``cols`` wide, row-major, with their
-        heights (local z, NaN = no data); where ``near_step`` is set (a much higher cell within
-        ``reach`` cells, default 2, :func:`near_step_mask`), a cell visible in the buffer is still
-        hidden when its ray towards the camera enters a cell within ``reach`` cells below that
-        cell's top by more than the depth tolerance. The depth buffer cannot see such occluders: their
+        heights (local z, NaN = no data); where ``near_step`` is set (a much higher cell within the
+        cell's ``reach``, cells, one integer or one per point, default 2, :func:`near_step_mask`), a
+        cell visible in the buffer is still hidden when its ray towards the camera enters a cell
+        within its reach below that cell's top by more than the depth tolerance. The depth buffer
+        cannot see such occluders: their
         depth lies within the tolerance, or between two buffer pixel centres (a ground cell
         diagonally next to a building's corner, seen past the corner).
     noise : (N,) float64, optional
@@ -1045,14 +1046,14 @@ def view_cells_into(
     if zbuf is None:
         zbuf = np.full((1, 1), np.inf, np.float32)
         window = (0, 0, 1, 1)
-    reach = 2
+    reach = np.full(n, 2, np.int64)
     if near_field is None:
         hloc, near_step, cols = np.zeros(0), np.zeros(n, np.bool_), 1
     else:
         hloc, near_step, cols = near_field[:3]
         cols = int(cols)
         if len(near_field) > 3:
-            reach = near_field[3]
+            reach = np.broadcast_to(np.asarray(near_field[3]), (n,))
         if (
             np.shape(hloc) != (n,)
             or np.shape(near_step) != (n,)
@@ -1060,15 +1061,15 @@ def view_cells_into(
             or cols < 1
             or n % cols
             or len(near_field) > 4
-            or isinstance(reach, bool)
-            or not isinstance(reach, int | np.integer)
-            or reach < 1
+            or reach.dtype.kind not in "iu"
+            or (n and reach.min() < 1)
         ):
             raise InputError(
                 "view_cells_into: near_field must be (N,) heights, (N,) bool, the grid's columns and "
-                "optionally the reach in cells (an integer >= 1)"
+                "optionally the reach in cells (an integer >= 1, or one per point)"
             )
         hloc = np.ascontiguousarray(hloc, np.float64)
+        reach = np.ascontiguousarray(reach, np.int64)
     if noise is None:
         hnoise = np.zeros(n)
     else:
@@ -1103,7 +1104,7 @@ def view_cells_into(
             hloc,
             near_step,
             cols,
-            int(reach),
+            reach,
             hnoise,
             usable,
             edge,
@@ -1113,10 +1114,10 @@ def view_cells_into(
     )
 
 
-def near_step_mask(heights: np.ndarray, res: float, step_cells: float = 2.0, reach: int = 2) -> np.ndarray:
-    """Cells (rows, cols) with a cell more than ``step_cells`` cell sizes higher within ``reach``
-    cells: where :func:`view_cells_into`'s near-field test runs (elsewhere the depth test is
-    enough)."""
+def near_step_mask(heights: np.ndarray, res: float, step_cells: float = 2.0, reach=2) -> np.ndarray:
+    """Cells (rows, cols) with a cell more than ``step_cells`` cell sizes higher within their reach
+    (``reach``: cells, one integer or one per cell): where :func:`view_cells_into`'s near-field
+    test runs (elsewhere the depth test is enough)."""
     from scipy.ndimage import maximum_filter
 
     h = np.asarray(heights, dtype=np.float64)
@@ -1125,12 +1126,17 @@ def near_step_mask(heights: np.ndarray, res: float, step_cells: float = 2.0, rea
     for name, v in (("res", res), ("step_cells", step_cells)):
         if isinstance(v, bool) or not (math.isfinite(float(v)) and float(v) > 0):
             raise InputError(f"near_step_mask: {name} must be a finite number > 0, got {v!r}")
-    if isinstance(reach, bool) or not isinstance(reach, int | np.integer) or reach < 1:
-        raise InputError(f"near_step_mask: reach must be an integer >= 1, got {reach!r}")
+    r = np.asarray(reach)
+    if r.dtype.kind not in "iu" or r.shape not in ((), h.shape) or (r.size and r.min() < 1):
+        raise InputError(f"near_step_mask: reach must be integers >= 1 (one, or one per cell), got {reach!r}")
+    r = np.broadcast_to(r, h.shape)
     hz = np.where(np.isfinite(h), h, -np.inf)
-    top = maximum_filter(hz, size=2 * int(reach) + 1, mode="constant", cval=-np.inf)
-    with np.errstate(invalid="ignore"):
-        return np.isfinite(h) & (top - h > float(step_cells) * float(res))
+    out = np.zeros(h.shape, bool)
+    for k in np.unique(r):
+        top = maximum_filter(hz, size=2 * int(k) + 1, mode="constant", cval=-np.inf)
+        with np.errstate(invalid="ignore"):
+            out |= (r == k) & np.isfinite(h) & (top - h > float(step_cells) * float(res))
+    return out
 
 
 def height_noise(heights: np.ndarray, half: int = 3, scale: int = 9) -> np.ndarray:

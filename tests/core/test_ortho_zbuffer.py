@@ -262,7 +262,8 @@ def _near_field_views(h, res, C, near_field: bool, noise=None, reach=None):
     if near_field:
         nf = (h.ravel().astype(float), near_step_mask(h, res).ravel(), cols)
         if reach is not None:
-            nf = (h.ravel().astype(float), near_step_mask(h, res, reach=reach).ravel(), cols, reach)
+            step = near_step_mask(h, res, reach=reach.reshape(h.shape)).ravel()
+            nf = (h.ravel().astype(float), step, cols, reach)
     view_cells_into(fc, P, P, np.zeros(n, bool), normals, R, C, cam, zbuf, (0, 0, 400, 400), 1.0, res, out,
                     near_field=nf, noise=noise)  # fmt: skip
     return out[0].reshape(rows, cols)
@@ -304,8 +305,8 @@ def test_near_field_reaches_as_far_as_the_noise_tolerance():
     n = h.size
     noise = np.full(n, 2.0 * np.sqrt(2.0) * 0.08)  # sigma 8 cm, as next to that wall
     reach = near_field_reach(noise, np.radians(45.0), res)
-    assert reach == 2 + 4 and near_field_reach(None, np.radians(45.0), res) == 2
-    assert near_field_reach(np.full(3, 100.0), np.radians(45.0), res) == NEAR_FIELD_MAX
+    assert (reach == 2 + 4).all() and (near_field_reach(np.zeros(3), np.radians(45.0), res) == 2).all()
+    assert (near_field_reach(np.full(3, 100.0), np.radians(45.0), res) == NEAR_FIELD_MAX).all()
     short = _near_field_views(h, res, C, near_field=True, noise=noise)
     far = _near_field_views(h, res, C, near_field=True, noise=noise, reach=reach)
     assert short[3, 7] and not far[3, 7]  # the cell 3 cells west of the wall
