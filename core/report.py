@@ -123,9 +123,8 @@ class Report:
         return str(hp), str(jp)
 
 
-#: Tables :func:`pipeline_report` adds after the orientation's (they belong to one run of the chain).
-#: The tables of the chain after the orientation (a reused orientation's report drops them); the
-#: stage table comes last (the workflow fills it in).
+#: Tables :func:`pipeline_report` adds after the orientation's (they belong to one run of the chain; a
+#: reused orientation's report drops them); the stage table comes last (the workflow fills it in).
 _CHAIN_TABLES = ("Dense matching and DSM filter", "Colour correction", "Stages")
 
 

@@ -100,6 +100,12 @@ def value_scale(dtype) -> float:
     return float(np.iinfo(dt).max) if dt.kind in "ui" else 1.0
 
 
+def value_range(dtype) -> tuple[float, float]:
+    """The values a dtype holds: its limits for integer dtypes, unbounded for float."""
+    dt = np.dtype(dtype)
+    return (float(np.iinfo(dt).min), float(np.iinfo(dt).max)) if dt.kind in "ui" else (-np.inf, np.inf)
+
+
 def uses_lab(bands: int) -> bool:
     """Whether data of ``bands`` bands is corrected in L*a*b* (RGB, RGB + one extra band)."""
     return bands in (3, 4)
@@ -187,7 +193,7 @@ class ColorCorrection:
         if self.is_identity(i) or len(s) == 0:
             return s
         dt = np.dtype(dtype)
-        lo, hi = (np.iinfo(dt).min, np.iinfo(dt).max) if dt.kind in "ui" else (-np.inf, np.inf)
+        lo, hi = value_range(dt)
         if self.has_rgb_stage(i) and uses_lab(s.shape[1]):
             g, o = self._rgb_stage(i, s.shape[1])
             s = np.clip(s * g + o, lo, hi)
@@ -203,7 +209,7 @@ class ColorCorrection:
         if colours.dtype != np.float32 or not colours.flags.c_contiguous or mask.shape != colours.shape[:-1]:
             raise InputError("apply_inplace: colours must be C-contiguous float32 (..., bands) like the mask")
         dt = np.dtype(dtype)
-        lo, hi = (float(np.iinfo(dt).min), float(np.iinfo(dt).max)) if dt.kind in "ui" else (-np.inf, np.inf)
+        lo, hi = value_range(dt)
         if uv is not None and self.has_vignetting(i):
             uv = np.asarray(uv)
             if uv.shape != mask.shape + (2,):
@@ -617,8 +623,7 @@ def estimate_colour_model(
     if not rgb_stage:
         return estimate_corrections(cell, img, to_channels(raw, dtype), n_images, **kwargs)
     first = estimate_corrections(cell, img, raw[:, :3], n_images, **kwargs)
-    dt = np.dtype(dtype)
-    lo, hi = (np.iinfo(dt).min, np.iinfo(dt).max) if dt.kind in "ui" else (-np.inf, np.inf)
+    lo, hi = value_range(dtype)
     staged = raw.copy()
     staged[:, :3] = np.clip(raw[:, :3] * first.gain[img] + first.offset[img], lo, hi)
     corr = estimate_corrections(

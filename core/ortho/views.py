@@ -49,6 +49,7 @@ NOISE_REACH = 9 // 2 + 3
 #: depth tolerance without the noise term; the noise term adds cells up to this bound).
 NEAR_FIELD_MAX = 8
 
+
 def near_field_reach(noise, max_view: float, res: float) -> np.ndarray:
     """Cells (int64, shaped like ``noise``) the near-field test of :func:`~.zbuffer.view_cells_into`
     must reach for cells with the height tolerances ``noise`` (metres, the noise term).
@@ -61,7 +62,16 @@ def near_field_reach(noise, max_view: float, res: float) -> np.ndarray:
     roof's omitted risers, where the noise estimate next to the wall read 8 cm). At most
     :data:`NEAR_FIELD_MAX`. Per cell, so the result does not depend on the tiling.
     """
+    def number(v) -> bool:
+        return isinstance(v, int | float | np.number) and not isinstance(v, bool) and math.isfinite(float(v))
+
+    if not (number(max_view) and 0.0 < float(max_view) < math.pi / 2):
+        raise InputError(f"near_field_reach: max_view must be in (0, pi/2) radians, got {max_view!r}")
+    if not (number(res) and float(res) > 0.0):
+        raise InputError(f"near_field_reach: res must be a cell size > 0 (metres), got {res!r}")
     a = np.asarray(noise, dtype=np.float64)
+    if (a < 0).any():
+        raise InputError("near_field_reach: noise must be heights >= 0 (metres)")
     extra = np.ceil(np.nan_to_num(a, nan=0.0) / (math.cos(max_view) * res))
     return (2 + np.clip(extra, 0, NEAR_FIELD_MAX - 2)).astype(np.int64)
 

@@ -307,6 +307,9 @@ def test_near_field_reaches_as_far_as_the_noise_tolerance():
     reach = near_field_reach(noise, np.radians(45.0), res)
     assert (reach == 2 + 4).all() and (near_field_reach(np.zeros(3), np.radians(45.0), res) == 2).all()
     assert (near_field_reach(np.full(3, 100.0), np.radians(45.0), res) == NEAR_FIELD_MAX).all()
+    for bad in ((noise, 2.0, res), (noise, np.radians(45.0), 0.0), (-noise, np.radians(45.0), res)):
+        with pytest.raises(Exception, match="near_field_reach"):
+            near_field_reach(*bad)
     short = _near_field_views(h, res, C, near_field=True, noise=noise)
     far = _near_field_views(h, res, C, near_field=True, noise=noise, reach=reach)
     assert short[3, 7] and not far[3, 7]  # the cell 3 cells west of the wall
