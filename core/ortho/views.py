@@ -512,6 +512,7 @@ def all_tile_views(
     # building's corner: within the depth tolerance, or between two buffer pixel centres)
     near_field = None
     noise = None
+    ray_grid = None
     if setup.visibility:
         reach = np.full(rows * cols, 2, np.int64)
         if setup.noise_tolerance > 0:
@@ -525,6 +526,7 @@ def all_tile_views(
             reach = near_field_reach(noise, setup.max_view, res)
         step = near_step_mask(h, res, reach=reach.reshape(h.shape)).ravel()
         near_field = (np.where(valid, lz, np.nan).ravel(), step, cols, reach)
+        ray_grid = _ray_grid(hreg, M, lx, ly, res, to_local.offset[2])
     # colour sample points: cells next to a height discontinuity are sampled a little inside their own
     # side, so the bilinear sample does not mix in the other side of a building outline
     S = P
@@ -609,6 +611,7 @@ def all_tile_views(
             setup.visibility,
             near_field=near_field,
             noise=noise,
+            ray_grid=ray_grid,
         )
         gsd_all[r] = gsd
 
@@ -659,6 +662,25 @@ def all_tile_views(
         top = np.zeros(K, np.bool_)
         _mark_top(eff, usable, int(setup.top_views), top)
     return TileViews(outer, h, cands, usable, edge, uv, eff, gsd, 0 if tris is None else len(tris), top)
+
+
+def _ray_grid(hreg: np.ndarray, margin: int, lx: np.ndarray, ly: np.ndarray, res: float, z_off: float):
+    """The ``ray_grid`` of :func:`~.zbuffer.view_cells_into` for a tile: the region's heights in the
+    local frame, the tile's offset in it, and the turn of local plan directions into columns and rows
+    (the local steps of one column and one row, from the tile's corners; exact when the output CRS is
+    the orientation's)."""
+    rows, cols = lx.shape
+    step_c = np.array([res, 0.0])
+    step_r = np.array([0.0, -res])
+    if cols > 1:
+        step_c = np.array([lx[0, -1] - lx[0, 0], ly[0, -1] - ly[0, 0]]) / (cols - 1)
+    if rows > 1:
+        step_r = np.array([lx[-1, 0] - lx[0, 0], ly[-1, 0] - ly[0, 0]]) / (rows - 1)
+    inv = np.linalg.inv(np.column_stack([step_c, step_r]))
+    hz = hreg - z_off
+    finite = np.isfinite(hz)
+    top = float(hz[finite].max()) if finite.any() else 0.0
+    return hz, int(margin), inv, top
 
 
 @njit

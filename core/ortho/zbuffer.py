@@ -47,7 +47,11 @@ pass of :func:`view_cells_into` therefore also follows the cell's own ray throug
 the 5 x 5 cells around it where one of them is much higher (:func:`near_step_mask`)
 and hides the cell when the ray enters a cell below its top by more than the
 same tolerance (on battery scene 4, ground cells diagonally next to a building's
-corner were textured with the building's colour).
+corner were textured with the building's colour). A cell near an occlusion edge
+is followed along its ray through the whole height grid around the tile
+(:func:`_ray_hidden`), as far as the ray can be hidden: next to an edge the
+buffer decides only to its pixel, and a ray past a diagonal roof outline or
+grazing a roof's edge runs between two of its pixel centres.
 """
 
 from __future__ import annotations
@@ -821,6 +825,54 @@ def _near_field_hidden(n, P, hloc, cols, res, C, tol_h, reach):
 
 
 @njit
+def _ray_hidden(hz, ri, ci, dr, dc, z0, rise, tol, ztop):
+    """Whether a ray leaving the point ``(ri, ci)`` (fractional row and column of a height grid
+    ``hz``, local heights, NaN = none) enters a cell below that cell's top by more than ``tol``.
+
+    The ray moves ``(dr, dc)`` rows and columns and rises ``rise`` metres per metre of horizontal
+    distance ``s``; its height at ``s`` is ``z0 + rise s``. The cells it crosses are walked in order
+    (Amanatides and Woo's traversal), each taken at the ray's height where it enters the cell, its
+    lowest point there. The walk ends where the ray leaves the grid (nothing known beyond: not
+    hidden) or rises above ``ztop + tol`` (no cell can be above it).
+    """
+    R, Cn = hz.shape
+    r = int(math.floor(ri))
+    c = int(math.floor(ci))
+    inf = np.inf
+    if dc > 0.0:
+        sc, tc, dtc = 1, (c + 1.0 - ci) / dc, 1.0 / dc
+    elif dc < 0.0:
+        sc, tc, dtc = -1, (c - ci) / dc, -1.0 / dc
+    else:
+        sc, tc, dtc = 0, inf, inf
+    if dr > 0.0:
+        sr, tr, dtr = 1, (r + 1.0 - ri) / dr, 1.0 / dr
+    elif dr < 0.0:
+        sr, tr, dtr = -1, (r - ri) / dr, -1.0 / dr
+    else:
+        sr, tr, dtr = 0, inf, inf
+    if sc == 0 and sr == 0:
+        return False
+    while True:
+        if tc < tr:
+            s = tc
+            c += sc
+            tc += dtc
+        else:
+            s = tr
+            r += sr
+            tr += dtr
+        if r < 0 or c < 0 or r >= R or c >= Cn:
+            return False
+        zr = z0 + s * rise
+        if zr > ztop + tol:
+            return False
+        h = hz[r, c]
+        if h > zr + tol:
+            return True
+
+
+@njit
 def _view_pass(
     cells,
     us,
@@ -848,6 +900,10 @@ def _view_pass(
     cols,
     reach,
     hnoise,
+    ray_hz,
+    ray_at,
+    ray_inv,
+    ray_top,
     usable,
     edge,
     uv,
@@ -864,6 +920,10 @@ def _view_pass(
     height noise, :func:`height_noise`). Where ``near_step`` is set (cells of a ``cols``-wide grid,
     heights ``hloc``, NaN = none), a cell that passes the depth test is still hidden when its ray
     enters a cell within ``reach[n]`` cells below that cell's top (:func:`_near_field_hidden`).
+    A cell next to an occlusion edge in the buffer is hidden when its ray enters a cell of
+    ``ray_hz`` (the heights around the grid, its cell ``(r, c)`` at ``(r + ray_at, c + ray_at)``;
+    empty: no test) below that cell's top, anywhere below ``ray_top`` (:func:`_ray_hidden`);
+    ``ray_inv`` turns a local plan direction into rows and columns.
     """
     H = zbuf.shape[0]
     W = zbuf.shape[1]
@@ -903,6 +963,21 @@ def _view_pass(
             # (the buffer's pixels cannot: the ray past a corner, an occluder within the tolerance)
             if near_step[n] and _near_field_hidden(n, P, hloc, cols, res, C, t, reach[n]):
                 continue
+            # next to an occlusion edge the buffer's pixels decide only to a pixel, and a ray past a
+            # roof's corner or edge (a diagonal outline, a grazing ray) runs between two of their
+            # centres: the cell's own ray through the raster decides, as far as the ray can be hidden
+            if near and ray_hz.shape[0] > 0:
+                rn = n // cols
+                dh = math.sqrt(dx * dx + dy * dy)
+                if dh > 1e-12:
+                    ux = dx / dh
+                    uy = dy / dh
+                    dc = ray_inv[0, 0] * ux + ray_inv[0, 1] * uy
+                    dr = ray_inv[1, 0] * ux + ray_inv[1, 1] * uy
+                    ri = rn + ray_at + 0.5
+                    ci = n - rn * cols + ray_at + 0.5
+                    if _ray_hidden(ray_hz, ri, ci, dr, dc, P[n, 2], dz / dh, t, ray_top):
+                        continue
         if moved[n]:
             su, sv, sz = _proj(S[n, 0], S[n, 1], S[n, 2], R, C, p_full, r2max)
             if sz <= 0.0:
@@ -993,6 +1068,7 @@ def view_cells_into(
     min_cos_inc: float = 0.02,
     near_field: tuple | None = None,
     noise: np.ndarray | None = None,
+    ray_grid: tuple | None = None,
 ) -> int:
     """Per-cell result of one image in one pass (the depth test of :func:`point_visibility` +
     incidence + sampling) for the cells of :func:`frame_cells`.
@@ -1023,6 +1099,15 @@ def view_cells_into(
         With the depth test: a height tolerance per cell (metres, >= 0) for the surface's own noise,
         added to the depth tolerance divided by the cosine of the viewing angle (see
         :func:`height_noise`); default 0.
+    ray_grid : (heights (R, C) float64, at int, inv (2, 2) float64, top float), optional
+        With the depth test and ``near_field``: the heights (local z, NaN = none) of a grid around
+        the points' grid, whose cell ``(r, c)`` is the heights' ``(r + at, c + at)``; ``inv`` turns
+        a local plan direction ``(x, y)`` into ``(columns, rows)``; ``top`` the highest height. A
+        cell near an occlusion edge (some buffer pixel of its 3 x 3 neighbourhood nearer than its
+        depth by more than the tolerance) is hidden when its ray towards the camera enters a cell
+        of that grid below the cell's top by more than the depth tolerance: next to an edge the
+        buffer decides only to its pixel (a diagonal roof outline, a grazing ray past a roof's edge
+        run between two pixel centres), the raster geometry exactly.
 
     Returns
     -------
@@ -1078,6 +1163,24 @@ def view_cells_into(
             raise InputError(
                 f"view_cells_into: noise must be ({n},) heights >= 0, got shape {hnoise.shape}"
             )
+    ray_hz, ray_at, ray_inv, ray_top = np.zeros((0, 0)), 0, np.zeros((2, 2)), 0.0
+    if ray_grid is not None:
+        if near_field is None or len(ray_grid) != 4:
+            raise InputError("view_cells_into: ray_grid must be (heights, at, inv, top), with near_field")
+        ray_hz = np.ascontiguousarray(ray_grid[0], np.float64)
+        ray_at = int(ray_grid[1])
+        ray_inv = np.ascontiguousarray(ray_grid[2], np.float64)
+        ray_top = float(ray_grid[3])
+        if ray_hz.ndim != 2 or ray_inv.shape != (2, 2) or ray_at < 0 or not math.isfinite(ray_top):
+            raise InputError(
+                "view_cells_into: ray_grid must be 2-D heights, an offset >= 0, a (2, 2) direction "
+                "transform and a finite top height"
+            )
+        if ray_hz.shape[0] < n // cols + 2 * ray_at or ray_hz.shape[1] < cols + 2 * ray_at:
+            raise InputError(
+                f"view_cells_into: ray_grid's heights {ray_hz.shape} do not hold the points' grid "
+                f"({n // cols} x {cols}) at offset {ray_at}"
+            )
     return int(
         _view_pass(
             fc.cells,
@@ -1106,6 +1209,10 @@ def view_cells_into(
             cols,
             reach,
             hnoise,
+            ray_hz,
+            ray_at,
+            ray_inv,
+            ray_top,
             usable,
             edge,
             uv,
