@@ -825,6 +825,18 @@ def _near_field_hidden(n, P, hloc, cols, res, C, tol_h, reach):
 
 
 @njit
+def _traversal_axis(x, d):
+    """One axis of a grid traversal from the coordinate ``x`` moving ``d`` cells per unit of the ray:
+    the step (-1, 0, 1), the ray's parameter at the first cell boundary, and between boundaries."""
+    k = math.floor(x)
+    if d > 0.0:
+        return 1, (k + 1.0 - x) / d, 1.0 / d
+    if d < 0.0:
+        return -1, (k - x) / d, -1.0 / d
+    return 0, np.inf, np.inf
+
+
+@njit
 def _ray_hidden(hz, ri, ci, dr, dc, z0, rise, tol, ztop):
     """Whether a ray leaving the point ``(ri, ci)`` (fractional row and column of a height grid
     ``hz``, local heights, NaN = none) enters a cell below that cell's top by more than ``tol``.
@@ -838,19 +850,8 @@ def _ray_hidden(hz, ri, ci, dr, dc, z0, rise, tol, ztop):
     R, Cn = hz.shape
     r = int(math.floor(ri))
     c = int(math.floor(ci))
-    inf = np.inf
-    if dc > 0.0:
-        sc, tc, dtc = 1, (c + 1.0 - ci) / dc, 1.0 / dc
-    elif dc < 0.0:
-        sc, tc, dtc = -1, (c - ci) / dc, -1.0 / dc
-    else:
-        sc, tc, dtc = 0, inf, inf
-    if dr > 0.0:
-        sr, tr, dtr = 1, (r + 1.0 - ri) / dr, 1.0 / dr
-    elif dr < 0.0:
-        sr, tr, dtr = -1, (r - ri) / dr, -1.0 / dr
-    else:
-        sr, tr, dtr = 0, inf, inf
+    sc, tc, dtc = _traversal_axis(ci, dc)
+    sr, tr, dtr = _traversal_axis(ri, dr)
     if sc == 0 and sr == 0:
         return False
     while True:
