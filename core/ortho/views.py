@@ -300,8 +300,9 @@ def _normals(h: np.ndarray, res: float, noise: np.ndarray | None = None) -> np.n
 
     ``noise`` (rows, cols), metres, optional: each difference is first shrunk towards 0 by the
     cell's noise term (what the depth test allows for the surface's own noise), so the bumps and
-    pits of a rough matched surface do not tilt its cells away from every camera. Without it (a
-    truth DSM reads 0) the differences are used as they are.
+    pits of a rough matched surface do not tilt its cells away from every camera. Without it, or
+    where it is 0 (a truth DSM, except sloped ground next to a wall, see :func:`height_noise`), the
+    differences are used as they are.
     """
     hh = np.ascontiguousarray(h, np.float64)
     nz = np.zeros(hh.shape) if noise is None else np.ascontiguousarray(noise, np.float64)
