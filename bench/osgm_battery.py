@@ -5,7 +5,7 @@ against 5 for the whole battery). The scenes are drawn as ``bench/acceptance.py`
 rendered once into ``--keep DIR`` (with the truth masks the figures need); later runs reuse them::
 
     source scripts/env.sh && python -P bench/osgm_battery.py --keep DIR [--tag NAME] [--only 0,2]
-        [--z-step-factor 1.5] [--uniqueness 0.99]
+        [--z-step-factor 1.5] [--uniqueness 0.99] [--set refine_edges=False ...]
 
 Prints, per scene, the OSGM wall time and the figures of ``acceptance.dsm_figures`` (completeness,
 NMAD in GSD, flat3, edge3), writes them to ``DIR/<tag>.json`` and each DSM to
@@ -17,6 +17,7 @@ loop (scenes 1-11 for times: the first scene also loads the compiled kernels).
 from __future__ import annotations
 
 import argparse
+import ast
 import json
 import os
 import pickle
@@ -63,6 +64,13 @@ def main(argv=None) -> int:
     ap.add_argument("--z-step-factor", type=float, default=0.0,
                     help="Z_STEP as a multiple of the cell (0: the default)")  # fmt: skip
     ap.add_argument("--uniqueness", type=float, default=None, help="OsgmConfig.uniqueness (default its own)")
+    ap.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="FIELD=VALUE",
+        help="another OsgmConfig field, as a Python literal (refine_edges=False); repeatable",
+    )
     args = ap.parse_args(argv)
     sys.path.insert(0, HERE)
     from acceptance import dsm_figures
@@ -72,6 +80,14 @@ def main(argv=None) -> int:
 
     indices = [int(v) for v in args.only.split(",") if v] or list(range(12))
     extra = {} if args.uniqueness is None else {"uniqueness": args.uniqueness}
+    for item in args.set:
+        name, sep, value = item.partition("=")
+        if not sep or name not in OsgmConfig.__dataclass_fields__:
+            ap.error(f"--set {item!r}: expected FIELD=VALUE with an OsgmConfig field")
+        try:
+            extra[name] = ast.literal_eval(value)
+        except (ValueError, SyntaxError):
+            ap.error(f"--set {item!r}: {value!r} is not a Python literal")
     results = {}
     for i in indices:
         folder = os.path.join(args.keep, f"scene_{i:02d}")

@@ -84,8 +84,9 @@ class OsgmConfig:
         Search range (world heights); default from sparse points and GCPs
         (0.5 / 99.5 percentiles, widened by a margin), else from the block.
     z_margin : float, optional
-        Margin around a coarse surface raster or the sparse range; default
-        ``max(5 dZ, 10 % of the range, 2 m)``.
+        Margin around the sparse range, default ``max(10 Z_STEP, 10 % of the range, 2 m)``,
+        and around a coarse surface raster, default ``max(5 Z_STEP, 2 m)`` (``Z_STEP`` counts
+        only when given).
     p1, p2 : int, optional
         SGM penalties in cost units (``COST_MAX`` = 1023 = unrelated windows);
         default :data:`~truortho.core.sgm.DEFAULT_P1`, ``DEFAULT_P2``.
