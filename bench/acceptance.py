@@ -211,6 +211,41 @@ def dsm_figures(dsm: np.ndarray, truth: np.ndarray, seen2: np.ndarray, edge: np.
     }
 
 
+def edge_failures(
+    dsm: np.ndarray, truth: np.ndarray, seen2: np.ndarray, edge: np.ndarray, gsd: float, res: float
+) -> dict:
+    """What the edge cells that ``edge3`` counts as wrong (off by more than 3 GSD) are, as shares of the
+    edge cells seen by two images or more (the four classes add up to ``1 - edge3``).
+
+    The side of a cell is that of its true height against the middle of the true heights around it
+    (the edge band plus one cell): ``edge_holes`` no height; ``edge_fattened`` a low-side cell (ground
+    at a wall's foot) above that middle, ``edge_eroded`` a high-side cell (a roof's rim) below it,
+    ``edge_own_side`` on its own side but off (a step placed a cell or two off, a roof's slope or
+    rim bent); ``edge_own_side_sloped`` the part of the latter where the true surface slopes more than
+    0.5 (a pitched roof's eaves and gables).
+    """
+    r = max(1, int(math.ceil(2.0 * gsd / res))) + 1
+    mid = 0.5 * (_maxf(truth, 2 * r + 1) + _minf(truth, 2 * r + 1))
+    cells = seen2 & edge
+    n = max(int(cells.sum()), 1)
+    e = dsm - truth
+    bad = cells & ~(np.abs(np.nan_to_num(e, nan=1e9)) <= 3 * gsd)
+    has = np.isfinite(dsm)
+    low = truth < mid
+    fat = bad & has & low & (dsm > mid)
+    ero = bad & has & ~low & (dsm < mid)
+    own = bad & has & ~fat & ~ero
+    gy, gx = np.gradient(np.where(np.isfinite(truth), truth, 0.0), res)
+    steep = np.hypot(gx, gy) > 0.5
+    return {
+        "edge_holes": float((bad & ~has).sum() / n),
+        "edge_fattened": float(fat.sum() / n),
+        "edge_eroded": float(ero.sum() / n),
+        "edge_own_side": float(own.sum() / n),
+        "edge_own_side_sloped": float((own & steep).sum() / n),
+    }
+
+
 def relative_delta_e(rgb: np.ndarray, truth_rgb: np.ndarray, valid: np.ndarray) -> float:
     """Mean dE after the best global per-channel gain and offset from the result to the truth.
 
@@ -344,6 +379,7 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     # the share of those with a height more than 3 GSD off
     one = nvis == 1
     row["osgm"]["wrong_seen1"] = float((one & (err > 3 * gsd) & np.isfinite(dsm)).sum() / max(one.sum(), 1))
+    row["osgm"].update(edge_failures(dsm, truth, seen2, edge, gsd, res))
     row["osgm"]["streak_index"] = streak_index(dsm)
     row["truth_streak_index"] = streak_index(truth)
     row["osgm"]["seconds"] = t_osgm
@@ -501,6 +537,11 @@ def summary(rows: list[dict]) -> list[str]:
         "osgm.nmad_parallax_px",
         "osgm.flat3_seen3",
         "osgm.wrong_seen1",
+        "osgm.edge_holes",
+        "osgm.edge_fattened",
+        "osgm.edge_eroded",
+        "osgm.edge_own_side",
+        "osgm.edge_own_side_sloped",
         "osgm_filtered.completeness",
         "osgm_filtered.nmad_gsd",
         "osgm_filtered.flat3",
