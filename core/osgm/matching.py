@@ -102,6 +102,15 @@ def slope_trend(guide_z: np.ndarray, z_base: float, dz: float, slope_max: int) -
     ground: on scene 9, following the coarse level's noise there raised the ground's NMAD from
     0.24 to 0.41 GSD), and where its range over ``TREND_SMOOTH + 2`` cells exceeds what a plane of
     ``slope_max`` levels per cell spans (a height step: its smoothed ramp must not invite a ramp).
+
+    That last rule took the trend from the lowest cells of every pitched roof, along its eaves, and
+    P1 flattened them there: on the battery (master seed 99, scene 2) a 45-degree roof read
+    6.3-6.4 m over its lowest 4-6 cells where the truth rises from 5.7 to 6.2 m; the raw cost of one
+    such cell was lowest at the true height, the aggregated one 0.55 m higher. On a step's high side
+    such a cell continues the slope of the nearest cell that kept its trend (:func:`_eave_trend`).
+    Measured with ``bench/osgm_battery.py`` on master seeds 2026 and 99: edge cells within 3 GSD up
+    on 17 of 24 scenes (up to 2.3 points; seed 99 scene 2: 76.2 -> 78.4 %), down on 5 by at most
+    0.5; flat3 within 0.2 points and NMAD within 0.004 GSD on every scene.
     """
     from scipy.ndimage import maximum_filter, minimum_filter, uniform_filter
 
@@ -123,12 +132,45 @@ def slope_trend(guide_z: np.ndarray, z_base: float, dz: float, slope_max: int) -
     span = TREND_SMOOTH + 2
     hi = maximum_filter(np.where(ok, gz, -np.inf), span, mode="nearest")
     lo = minimum_filter(np.where(ok, gz, np.inf), span, mode="nearest")
-    keep = (
-        np.isfinite(t)
-        & (np.hypot(gx, gy) >= TREND_MIN_SLOPE)
-        & (hi - lo <= (span - 1) * slope_max * dz)
-    )
+    flat_enough = hi - lo <= (span - 1) * slope_max * dz
+    keep = np.isfinite(t) & (np.hypot(gx, gy) >= TREND_MIN_SLOPE) & flat_enough
+    # next to a step, on its high side: the eaves of a roof
+    eaves = ok & np.isfinite(t) & ~flat_enough & (gz > 0.5 * (hi + lo))
+    if keep.any() and eaves.any():
+        zl = np.where(ok, (gz - z_base) / dz, np.nan)
+        t, keep = _eave_trend(t, gx, gy, zl, keep, eaves, float(slope_max), span)
     return np.where(keep, np.rint(np.nan_to_num(t, nan=0.0)), TREND_NONE).astype(np.int32)
+
+
+#: A cell takes the slope of the nearest cell with a trend (:func:`_eave_trend`) only when it lies
+#: within this angle's cosine of that cell's downslope direction (45 degrees: the eaves below a
+#: roof's slope, not a gable, where the ridge runs towards the step and a slope continued along it
+#: would cut the ridge).
+EAVE_COS = math.cos(math.radians(45.0))
+#: Levels by which a cell's coarser height may depart from a plane of the largest slope through the
+#: nearest cell with a trend and still count as the same surface (the coarser level's rounding).
+EAVE_TOL = 1.0
+
+
+def _eave_trend(t, gx, gy, zl, keep, eaves, slope_max: float, reach: int):
+    """The trend (levels) continued from the cells that keep one into the ``eaves`` cells: the value
+    and slope of the nearest cell with a trend, extrapolated to the cell, where that cell is at most
+    ``reach`` cells away, the cell lies downslope of it (:data:`EAVE_COS`) and its coarser height
+    ``zl`` is within what ``slope_max`` levels per cell (plus :data:`EAVE_TOL`) reach from that
+    cell's (the same surface, not the far side of the step). Returns the new ``t`` and ``keep``."""
+    from scipy.ndimage import distance_transform_edt
+
+    _, (ir, ic) = distance_transform_edt(~keep, return_indices=True)
+    rr, cc = np.indices(t.shape)
+    dr, dc = rr - ir, cc - ic
+    dist = np.hypot(dr, dc)
+    sx, sy = gx[ir, ic], gy[ir, ic]
+    ext = t[ir, ic] + sy * dr + sx * dc
+    with np.errstate(invalid="ignore"):
+        downslope = -(sy * dr + sx * dc) >= EAVE_COS * np.hypot(sx, sy) * dist
+        same = np.abs(zl - zl[ir, ic]) <= slope_max * dist + EAVE_TOL
+    take = eaves & (dist <= reach) & downslope & same & np.isfinite(ext)
+    return np.where(take, ext, t), keep | take
 
 
 #: Points across a tile at which the image choice counts views (:func:`_select`).

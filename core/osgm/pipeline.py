@@ -64,9 +64,9 @@ DSM_NODATA = -9999.0
 #: Part of every cached tile's key: raise it when a change of the matching or of the edge
 #: refinement changes the tiles for the same inputs and parameters (2: the edge refinement's
 #: visibility march and better-half cost; 3: wall heights decided like holes; 4: only where a side
-#: is more photo-consistent than the height itself), so that a cache kept from an interrupted run
-#: of an older version is not reused.
-CACHE_VERSION = 4
+#: is more photo-consistent than the height itself; 5: the slope trend continued down to a roof's
+#: eaves), so that a cache kept from an interrupted run of an older version is not reused.
+CACHE_VERSION = 5
 
 
 @dataclass

@@ -949,6 +949,29 @@ def test_slope_trend_and_adaptive_p2_are_independent(small_scene, monkeypatch, a
     assert (tasks[0].guide is not None) == (adaptive_p2 or slope_max > 0)
 
 
+def test_slope_trend_follows_a_roof_down_to_its_eaves_but_not_along_a_gable():
+    from truortho.core.osgm.matching import slope_trend
+    from truortho.core.sgm import TREND_NONE
+
+    dz = 0.1
+    cols = np.arange(40)[None, :]
+    rows = np.arange(30)[:, None]
+    # eaves: flat ground west of column 20, a roof rising one level per cell eastwards from 2 m
+    eaves = np.broadcast_to(np.where(cols < 20, 0.0, 2.0 + (cols - 20) * dz), (30, 40))
+    tr = slope_trend(eaves, 0.0, dz, 2)
+    roof = tr[8:22, 20:23]  # the roof's cells within three of the step: the box mean straddles it
+    assert (roof != TREND_NONE).all()
+    assert np.array_equal(roof, np.broadcast_to(np.arange(20, 23), roof.shape))  # the roof's own levels
+    assert (tr[8:22, 23:38] == np.arange(23, 38)).all()  # farther in, as before
+    assert (tr[8:22, :20] == TREND_NONE).all()  # the ground, at the wall's foot too: absolute levels
+    # a gable: the roof rises along the wall (northwards); a slope continued towards the wall would
+    # run across it, so the cells next to the step keep absolute levels
+    gable = np.where(cols < 20, 0.0, 2.0 + (29 - rows) * dz)
+    tg = slope_trend(gable, 0.0, dz, 2)
+    assert (tg[8:22, 20:23] == TREND_NONE).all()
+    assert (tg[8:22, 24:38] != TREND_NONE).all()
+
+
 def test_slope_trend_rejects_bad_input():
     from truortho.core.osgm.matching import slope_trend
 
