@@ -821,6 +821,59 @@ def test_steep_views_only_where_the_near_ones_leave_points_short():
     assert _rim_views(near, chosen, []) == []
 
 
+def _look_at(C, T):
+    """Rotation (world -> camera: x right, y down, z forward) of a camera at C looking at T."""
+    z = np.asarray(T, float) - np.asarray(C, float)
+    z /= np.linalg.norm(z)
+    x = np.cross(z, [0.0, 0.0, 1.0])
+    x /= np.linalg.norm(x)
+    return np.vstack([x, np.cross(z, x), z])
+
+
+class _FlatPyramid:
+    """The two calls :func:`~truortho.core.osgm.matching.choose_images` makes of a pyramid."""
+
+    def __init__(self, sizes):
+        self.sizes = sizes
+
+    def level_size(self, index, level):
+        w, h = self.sizes[index]
+        return w >> level, h >> level
+
+    def window(self, index, level, u0, v0, w, h, colour=False):
+        return np.zeros((h, w), np.float32)
+
+
+@pytest.mark.parametrize("shift", [12.0, 5.0])
+def test_image_choice_counts_frames_at_the_bottom_and_top_of_the_tile_range(shift):
+    """The surface may lie anywhere in a tile's height range. A nadir frame shifted 12 m covers the
+    tile's western points at mid-height (10 m) but not at its top (20 m), where only the centred
+    frame sees them: the oblique beyond ``max_view_angle`` must then be taken for them. Shifted
+    5 m it covers them at every height, and no oblique is needed."""
+    from truortho.core.geometry.camera import Camera
+    from truortho.core.osgm.matching import TileParams, View, choose_images
+
+    f, H = 1000.0, 100.0
+    nadir = np.diag([1.0, -1.0, -1.0])
+    cam = Camera(400, 400, f, f, 199.5, 199.5)
+    wide = Camera(2000, 2000, f, f, 999.5, 999.5)
+    C_obl = np.array([5.0 - 90.0 * math.tan(math.radians(55.0)), -5.0, H])
+    views = [
+        View(0, nadir, np.array([5.0, -5.0, H]), cam, 4.0, 1.0),
+        View(1, nadir, np.array([5.0 + shift, -5.0, H]), cam, 4.0, 1.0),
+        View(2, _look_at(C_obl, [5.0, -5.0, 10.0]), C_obl, wide, 4.0, math.cos(math.radians(55.0))),
+    ]
+    params = TileParams(radius=1, measure="gradient", p1=8, p2=96, paths=8, uniqueness=0.9,
+                        max_images=8, max_view_angle=50.0, median=0, rim_view_angle=65.0)  # fmt: skip
+    pyr = _FlatPyramid([(400, 400), (400, 400), (2000, 2000)])
+    # the tile: X 0-10 m, Y -10-0 m, heights 0-20 m
+    got = [im.view.index for im in choose_images(views, pyr, 0.0, 0.0, 0.1, 100, 100, 0.0, 20.0, params)]
+    assert sorted(got) == ([0, 1, 2] if shift == 12.0 else [0, 1])
+    # a tile of one height (a finer level's narrow range): mid-height only, where frame 1 covers it
+    flat = [im.view.index for im in choose_images(views, pyr, 0.0, 0.0, 0.1, 100, 100, 10.0, 10.0, params)]
+    assert sorted(flat) == [0, 1]
+
+
 def test_tile_seams_are_blended_where_the_tiles_agree_and_cut_where_they_do_not():
     """Neighbouring tiles match with different images and borders: their heights differ slightly
     at a seam, which a hard cut shows as a straight line on the tile grid. Within the blend band
