@@ -143,6 +143,41 @@ def slope_trend(guide_z: np.ndarray, z_base: float, dz: float, slope_max: int) -
     return np.where(keep, np.rint(np.nan_to_num(t, nan=0.0)), TREND_NONE).astype(np.int32)
 
 
+#: Aggregations of a tile that take the trend of the tile's own result (:func:`aggregate_with_trend`).
+TREND_PASSES = 1
+
+
+def aggregate_with_trend(cost, params: TileParams, z0, guide, trend, valid, z_base: float, dz: float,
+                         passes: int = TREND_PASSES) -> np.ndarray:  # fmt: skip
+    """SGM aggregation (:func:`~truortho.core.sgm.aggregate`) of a tile's ``cost`` with ``trend`` (the
+    coarser level's, :func:`slope_trend`; None on the coarsest level), then ``passes`` times again
+    with the trend of the heights the last one selected (``valid``: the cells selected). Returns
+    the last aggregated volume. Without ``params.slope_max`` there is no trend and one aggregation.
+
+    The trend a level hands on is flatter than the roof: the coarsest level has none, and each
+    level pays P1 where its data term is too weak to follow the slope its coarser level missed.
+    On battery scene 0 (master seed 2026) a roof rising 0.08 m per cell from its eaves at 8.9 m
+    read 10.3 m flat on the coarsest level, 9.65-10.6 m where the truth spans 8.9-10.8 m on the
+    next, and 9.45-9.6 m over its lowest 8 cells on the finest. A pass with the level's own trend
+    lets SGM follow the slope it found without paying for it, and go further where the data ask.
+    Measured with ``bench/osgm_battery.py`` on master seeds 2026 and 99: edge cells within 3 GSD
+    up on 22 of 24 scenes (seed 2026 scene 0 75.4 -> 79.8 %, seed 99 scene 2 78.4 -> 81.7 %),
+    down on 2 by at most 0.1 point; flat3 within -0.0/+0.8 points, NMAD within +0.012/-0.039 GSD;
+    OSGM time about 10-30 % more. A second pass added at most 1 point of edge3 on any scene;
+    passes on the coarser levels alone kept less than half the gain.
+    """
+    if params.slope_max <= 0:
+        passes = 0
+    for _ in range(passes):
+        S = aggregate(cost, params.p1, params.p2, params.paths, z0, guide=guide, trend=trend,
+                      trend_max=params.slope_max)  # fmt: skip
+        level, _ = select(S, z0, params.uniqueness, valid=valid)
+        del S
+        trend = slope_trend(z_base + level.astype(np.float64) * dz, z_base, dz, params.slope_max)
+    return aggregate(cost, params.p1, params.p2, params.paths, z0, guide=guide, trend=trend,
+                     trend_max=params.slope_max)  # fmt: skip
+
+
 #: A cell takes the slope of the nearest cell with a trend (:func:`_eave_trend`) only when it lies
 #: within this angle's cosine of that cell's downslope direction (45 degrees: the eaves below a
 #: roof's slope, not a gable, where the ridge runs towards the step and a slope continued along it
@@ -551,9 +586,9 @@ def match_tile(
     trend = None
     if params.slope_max > 0 and guide_z is not None:
         trend = slope_trend(guide_z, z_base, dz, params.slope_max)
-    S = aggregate(cost, params.p1, params.p2, params.paths, z0, guide=guide, trend=trend,
-                  trend_max=params.slope_max)  # fmt: skip
-    level, conf = select(S, z0, params.uniqueness, valid=valid_cells(cost) & search)
+    valid = valid_cells(cost) & search
+    S = aggregate_with_trend(cost, params, z0, guide, trend, valid, z_base, dz)
+    level, conf = select(S, z0, params.uniqueness, valid=valid)
     del S
     li = np.rint(np.nan_to_num(level, nan=-1e9)).astype(np.int64)
     edge = np.isfinite(level) & ((li <= lo) | (li >= hi))

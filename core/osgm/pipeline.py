@@ -65,9 +65,10 @@ DSM_NODATA = -9999.0
 #: refinement changes the tiles for the same inputs and parameters (2: the edge refinement's
 #: visibility march and better-half cost; 3: wall heights decided like holes; 4: only where a side
 #: is more photo-consistent than the height itself; 5: the slope trend continued down to a roof's
-#: eaves; 6: the image choice tests frames at the bottom and top of a tile's range too), so that
-#: a cache kept from an interrupted run of an older version is not reused.
-CACHE_VERSION = 6
+#: eaves; 6: the image choice tests frames at the bottom and top of a tile's range too; 7: a second
+#: aggregation with the tile's own trend), so that a cache kept from an interrupted run of an older
+#: version is not reused.
+CACHE_VERSION = 7
 
 
 @dataclass
