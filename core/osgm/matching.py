@@ -168,6 +168,8 @@ def aggregate_with_trend(cost, params: TileParams, z0, guide, trend, valid, z_ba
     A second pass added at most 1 point of edge3 on any scene; passes on the coarser levels alone
     kept less than half the gain.
     """
+    if isinstance(passes, bool) or not isinstance(passes, int | np.integer) or passes < 0:
+        raise InputError(f"aggregate_with_trend: passes must be an integer >= 0, got {passes!r}")
     if params.slope_max <= 0:
         passes = 0
     for _ in range(passes):

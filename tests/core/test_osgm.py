@@ -1069,6 +1069,9 @@ def test_a_pass_with_its_own_trend_follows_a_weak_roof_down_to_its_eaves():
     S0 = aggregate_with_trend(cost, TileParams(**flat), z0, None, None, valid, 0.0, 1.0, passes=3)
     S1 = aggregate_with_trend(cost, TileParams(**flat), z0, None, None, valid, 0.0, 1.0, passes=0)
     assert np.array_equal(S0, S1)
+    for bad in (-1, 1.5, True):
+        with pytest.raises(InputError, match="passes must be an integer >= 0"):
+            aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, passes=bad)
 
 
 def test_slope_trend_rejects_bad_input():
