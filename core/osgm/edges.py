@@ -12,16 +12,17 @@ evidence that no straddling window mixes:
 1. **Zone**: cells within ``reach`` cells of a step (the 3 x 3 height range exceeds ``step``).
 2. **Candidates**: in the cell's ``(2 w + 1)^2`` neighbourhood the heights split at the middle of
    their range into a low and a high side; each side's candidate is the median of its cells.
-3. **Visibility**: a view takes part for a candidate only if its ray from the cell at that height
-   passes above the current surface (a march over the tile's heights), so the views that cannot
-   see the foot of a wall do not vote for it; this is the occlusion-aware cost, made against
-   the current surface estimate. The march starts :data:`NEAR` cells away from the cell: the
-   cells nearer than that are the ones this pass re-decides, and a fattened band of roof height
-   in front of the foot of a wall would otherwise hide the ground from the very views that show
-   it is ground (on battery scene 10, 52-97 % of the edge cells left on the wrong side had no
-   pair of views on their true side). A real wall within those cells is still seen by the
-   march further on, where the roof behind it stands above the ray; a view it hides nearer
-   than that is outvoted by the next step.
+3. **Visibility**: the views are every image whose frame covers the tile, not only the ones the
+   tile matched with (:func:`~.matching.edge_images`). A view takes part for a candidate only if
+   its ray from the cell at that height passes above the current surface (a march over the tile's
+   heights), so the views that cannot see the foot of a wall do not vote for it; this is the
+   occlusion-aware cost, made against the current surface estimate. The march starts :data:`NEAR`
+   cells away from the cell: the cells nearer than that are the ones this pass re-decides, and a
+   fattened band of roof height in front of the foot of a wall would otherwise hide the ground
+   from the very views that show it is ground (on battery scene 10, 52-97 % of the edge cells left
+   on the wrong side had no pair of views on their true side). A real wall within those cells is
+   still seen by the march further on, where the roof behind it stands above the ray; a view it
+   hides nearer than that is outvoted by the next step.
 4. **Photo-consistency**: a 3 x 3 cell patch on the candidate's plane, sampled in every visible
    view (bilinear, the matching band, normalised per view to zero mean and unit spread over the
    tile: gain and offset invariant), compared between every pair of visible views (mean
@@ -311,9 +312,28 @@ def _between(zc, cand, step):
     return np.isfinite(zc) & (np.abs(zc - cand[0]) > step) & (np.abs(zc - cand[1]) > step)
 
 
+#: Cells whose samples in every view :func:`_cost_at` holds at once: its memory is ``views x CHUNK
+#: x 37`` bytes (a 3 x 3 float32 patch and a visibility flag per view and cell), whatever the tile
+#: and however many images cover it (:func:`~.matching.edge_images`).
+CHUNK = 16384
+
+
 def _cost_at(zz, bmax, ri, ci, heights, images, stats, x0, y0, res, tol, ztop):
     """Photo-consistency ``(cost, pairs)`` of the listed cells at ``heights`` (steps 3 and 4);
-    ``bmax``: :func:`block_max` of the heights ``zz``."""
+    ``bmax``: :func:`block_max` of the heights ``zz``. In chunks of :data:`CHUNK` cells."""
+    n = ri.size
+    cost = np.empty(n, np.float64)
+    pairs = np.zeros(n, np.int64)
+    heights = np.asarray(heights, np.float64)
+    for s in range(0, n, CHUNK):
+        e = min(n, s + CHUNK)
+        cost[s:e], pairs[s:e] = _cost_chunk(
+            zz, bmax, ri[s:e], ci[s:e], heights[s:e], images, stats, x0, y0, res, tol, ztop
+        )
+    return cost, pairs
+
+
+def _cost_chunk(zz, bmax, ri, ci, heights, images, stats, x0, y0, res, tol, ztop):
     n = ri.size
     dr, dc = np.meshgrid(np.arange(-1, 2), np.arange(-1, 2), indexing="ij")
     dr, dc = dr.ravel(), dc.ravel()
@@ -327,6 +347,8 @@ def _cost_at(zz, bmax, ri, ci, heights, images, stats, x0, y0, res, tol, ztop):
         np.repeat(heights, 9),
     ])  # fmt: skip
     h = np.ascontiguousarray(heights, np.float64)
+    ri = np.ascontiguousarray(ri)
+    ci = np.ascontiguousarray(ci)
     for v, img in enumerate(images):
         free = np.empty(n, np.bool_)
         C = np.asarray(img.view.C, np.float64)
