@@ -367,28 +367,6 @@ def choose_images(
     return out
 
 
-def edge_images(views, pyr, x0, y0, res, rows, cols, z_lo, z_hi, params: TileParams, chosen):
-    """The images the edge refinement (:mod:`.edges`) of a tile weighs: every image whose frame
-    covers the tile, where matching took ``chosen``, its ``params.max_images`` (:func:`choose_images`).
-
-    Matching needs a few good views per point and pays for every image at every level; the
-    refinement decides a cell by the pairs of views that see it past the current surface, and the
-    ground at the foot of a wall is seen by few images, often ones the tile's choice left out
-    because they add little elsewhere. On battery scene 9 (master seed 2026) the tile's 12 images
-    held 2 of the 6 photos that see the ground at the foot of one east wall. Giving the refinement
-    every image that covers the tile: edge cells within 3 GSD 77.5 -> 78.5 % there, +0.0 to +0.2
-    points on the other scenes of master seeds 2026 and 99, every other figure unchanged
-    (``bench/osgm_battery.py``); the refinement samples 3 x 3 patches at the cells near a step
-    only, so the extra images cost little.
-    """
-    if len(views) <= params.max_images:
-        return chosen
-    import dataclasses
-
-    return choose_images(views, pyr, x0, y0, res, rows, cols, z_lo, z_hi,
-                         dataclasses.replace(params, max_images=len(views)))  # fmt: skip
-
-
 def _remap(img: TileImage, x0, y0, res, rows, cols, z) -> np.ndarray:
     import cv2
 
@@ -630,7 +608,5 @@ def match_tile(
     if params.edges:
         from .edges import refine_edges
 
-        z = refine_edges(z, edge_images(views, pyr, x0, y0, res, rows, cols, z_base + a_min * dz,
-                                        z_base + a_max * dz, params, images),
-                         x0, y0, res, max(1.0, 4.0 * dz), 2.0 * dz, cancelled, conf)  # fmt: skip
+        z = refine_edges(z, images, x0, y0, res, max(1.0, 4.0 * dz), 2.0 * dz, cancelled, conf)
     return TileResult(z, conf.astype(np.float32), images, evaluated, nd)

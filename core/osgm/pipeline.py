@@ -66,10 +66,9 @@ DSM_NODATA = -9999.0
 #: visibility march and better-half cost; 3: wall heights decided like holes; 4: only where a side
 #: is more photo-consistent than the height itself; 5: the slope trend continued down to a roof's
 #: eaves; 6: the image choice tests frames at the bottom and top of a tile's range too; 7: a second
-#: aggregation with the tile's own trend; 8: the edge refinement weighs every image covering the
-#: tile), so that a cache kept from an interrupted run of an older
+#: aggregation with the tile's own trend), so that a cache kept from an interrupted run of an older
 #: version is not reused.
-CACHE_VERSION = 8
+CACHE_VERSION = 7
 
 
 @dataclass
@@ -467,8 +466,7 @@ def _match_system(
                 cache=cache,
                 key=(lambda t: t.key(base)) if cache is not None else None,
                 label=f"{system.name}: level {lv}",
-                memory=task_memory(side, side, MAX_BAND, params.max_images, 4 * side * side,
-                                   len(views) if lv == 0 and params.edges else 0),  # fmt: skip
+                memory=task_memory(side, side, MAX_BAND, params.max_images, 4 * side * side),
             )
         except CancelledError:
             raise CancelledError("OSGM cancelled") from None

@@ -235,17 +235,8 @@ def osgm_tile_task(ctx: TileContext, task: TileTask) -> tuple[np.ndarray, np.nda
     return np.ascontiguousarray(res.z[ins]), np.ascontiguousarray(res.confidence[ins])
 
 
-def task_memory(
-    rows: int, cols: int, nd: int, n_images: int, window_pixels: int, edge_images: int = 0
-) -> int:
-    """Bytes one task needs at most (module docstring): volumes, windows, per-cell arrays.
-
-    ``edge_images``: the images the finest level's edge refinement may weigh (every image whose
-    frame covers a tile, :func:`~.matching.edge_images`; 0: no refinement). It runs after the
-    sweep, with the cost volume still held, on :data:`~.edges.CHUNK` cells at a time.
-    """
-    from .edges import CHUNK
-
+def task_memory(rows: int, cols: int, nd: int, n_images: int, window_pixels: int) -> int:
+    """Bytes one task needs at most (module docstring): volumes, windows, per-cell arrays."""
     cells = int(rows) * int(cols)
     volumes = cells * int(nd) * 2 * 2  # cost + aggregated, uint16
     windows = int(n_images) * int(window_pixels) * 4  # float32 image windows
@@ -254,11 +245,4 @@ def task_memory(
     # the plane sweep's work arrays (.sweep): samples, gradients and validity per image, terms per pair
     sweep = cells * (n * (4 + 2 + 2 + 1) + (n * (n - 1) // 2) * 3)
     # and its windows packed once more into one buffer
-    matching = volumes + 2 * windows + per_cell + sweep
-    m = int(edge_images)
-    if m <= 0:
-        return matching
-    # the cost volume, the matched images' windows and the refinement's: its samples, 3 x 3 float32
-    # and a visibility flag per image and cell of a chunk, and its per-cell arrays
-    refine = volumes // 2 + windows + m * int(window_pixels) * 4 + m * CHUNK * 37 + per_cell
-    return max(matching, refine)
+    return volumes + 2 * windows + per_cell + sweep

@@ -9,7 +9,6 @@ Obliques: facade points appear only with the oblique reference systems.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 
 import numpy as np
@@ -884,54 +883,6 @@ def test_image_choice_counts_frames_at_the_bottom_and_top_of_the_tile_range(shif
     # a tile of one height (a finer level's narrow range): mid-height only, where frame 1 covers it
     flat = [im.view.index for im in choose_images(views, pyr, 0.0, 0.0, 0.1, 100, 100, 10.0, 10.0, params)]
     assert sorted(flat) == [0, 1]
-
-
-def test_edge_refinement_weighs_every_image_that_covers_the_tile_not_only_the_chosen():
-    """Matching takes ``max_images`` images per tile, the most nadir ones once every point has its
-    views; the edge refinement weighs every image whose frame covers the tile (the few photos that
-    see the foot of a wall are often the ones left out). Frames that miss the tile stay out, and
-    with no more images than ``max_images`` the refinement gets the matching's own set."""
-    from truortho.core.geometry.camera import Camera
-    from truortho.core.osgm.matching import TileParams, View, choose_images, edge_images
-
-    f, H = 1000.0, 100.0
-    nadir = np.diag([1.0, -1.0, -1.0])
-    cam = Camera(400, 400, f, f, 199.5, 199.5)
-    # four frames over the tile, one 300 m away; obliques at 20-35 degrees from the four sides
-    views = [View(k, nadir, np.array([5.0 + dx, -5.0, H]), cam, 4.0, 1.0)
-             for k, dx in enumerate((0.0, 1.0, -1.0, 300.0))]  # fmt: skip
-    for k, (az, tilt) in enumerate(((0, 20), (90, 25), (180, 30), (270, 35)), start=4):
-        d = H * math.tan(math.radians(tilt))
-        C = np.array([5.0 + d * math.sin(math.radians(az)), -5.0 + d * math.cos(math.radians(az)), H])
-        views.append(View(k, _look_at(C, [5.0, -5.0, 0.0]), C, cam, 4.0, math.cos(math.radians(tilt))))
-    params = TileParams(radius=1, measure="gradient", p1=8, p2=96, paths=8, uniqueness=0.9,
-                        max_images=3, max_view_angle=50.0, median=0, rim_view_angle=65.0)  # fmt: skip
-    pyr = _FlatPyramid([(400, 400)] * len(views))
-    args = (views, pyr, 0.0, 0.0, 0.1, 100, 100, 0.0, 2.0)
-    chosen = choose_images(*args, params)
-    assert len(chosen) == 3
-    every = sorted(im.view.index for im in edge_images(*args, params, chosen))
-    assert every == [0, 1, 2, 4, 5, 6, 7]  # not frame 3, which misses the tile
-    assert {im.view.index for im in chosen} < set(every)
-    few = dataclasses.replace(params, max_images=len(views))
-    assert edge_images(*args, few, chosen) is chosen
-
-
-def test_task_memory_counts_the_edge_refinements_images_in_bounded_chunks():
-    """The finest level's tasks ask the scheduler for the edge refinement's memory too: the windows
-    of every image it may weigh and one chunk of samples per image, not the whole tile's."""
-    from truortho.core.osgm.edges import CHUNK
-    from truortho.core.osgm.tiles import task_memory
-
-    side, nd, win = 320, 192, 4 * 320 * 320
-    base = task_memory(side, side, nd, 12, win)
-    assert task_memory(side, side, nd, 12, win, 0) == base
-    few, many = task_memory(side, side, nd, 12, win, 12), task_memory(side, side, nd, 12, win, 41)
-    assert base <= few < many  # 41 images (copr) need more than the matching's 12
-    assert many - base <= 41 * (win * 4 + CHUNK * 37)  # chunks: nothing per cell of the tile
-    # a larger tile raises the refinement's share by its windows and per-cell arrays only
-    big = task_memory(2 * side, 2 * side, nd, 12, 4 * win, 41)
-    assert big - task_memory(2 * side, 2 * side, nd, 12, 4 * win) <= 41 * (4 * win * 4 + CHUNK * 37)
 
 
 def test_tile_seams_are_blended_where_the_tiles_agree_and_cut_where_they_do_not():
