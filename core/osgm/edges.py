@@ -349,8 +349,6 @@ def _cost_chunk(zz, bmax, ri, ci, heights, images, stats, x0, y0, res, tol, ztop
         np.repeat(heights, 9),
     ])  # fmt: skip
     h = np.ascontiguousarray(heights, np.float64)
-    ri = np.ascontiguousarray(ri)
-    ci = np.ascontiguousarray(ci)
     for v, img in enumerate(images):
         free = np.empty(n, np.bool_)
         C = np.asarray(img.view.C, np.float64)
