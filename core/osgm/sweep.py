@@ -23,8 +23,9 @@ same arithmetic as the dense saturated-gradient cost
 4. for every searching cell, the window sums of every pair (running sums
    down the columns of a strip and along runs of searching cells), the pair
    contributions ``min(1, mean (|dgx| + |dgy|) / 2)`` and the mean of the
-   best pairs (:func:`~truortho.core.sgm.cost._combine`), written straight
-   into the tile's cost volume (:func:`_window_cost`).
+   best pairs (as :func:`~truortho.core.sgm.cost._combine`, found by bisection:
+   :func:`_smallest_mean`), written straight into the tile's cost volume
+   (:func:`_window_cost`).
 
 Comparing every view with the per-sample median of the views instead of
 every pair (``n`` terms instead of ``n (n - 1) / 2``) was measured on the
@@ -43,8 +44,9 @@ import numpy as np
 
 from ..errors import InputError
 from ..jit import njit, pjit, prange
+from ..quickselect import select_rank
 from ..sgm import COST_MAX
-from ..sgm.cost import _GQ, _combine, _diff1, _gradient_scale, _gradients, _need, _quantise, _window_cells
+from ..sgm.cost import _GQ, _auto_k, _diff1, _gradient_scale, _gradients, _need, _quantise, _window_cells
 
 #: Rows per parallel strip of the window sums.
 STRIP = 32
@@ -231,20 +233,146 @@ def _pair_terms(qx, qy, vv, win, box, pi, pj, td, tm):
 
 
 @njit
-def _add_sample(td, tm, vv, rr, cc, sign, vd, vm, vc):
-    """Adds (sign +1) or removes (-1) sample (rr, cc) to the column sums of every term and view."""
-    for q in range(td.shape[2]):
-        vd[cc, q] += sign * np.int32(td[rr, cc, q])
-        vm[cc, q] += sign * np.int32(tm[rr, cc, q])
-    for i in range(vv.shape[2]):
-        vc[cc, i] += sign * np.int32(vv[rr, cc, i])
+def _col_step(td, tm, vv, ra, rs, cc, vd, vm, vc):
+    """Column ``cc``'s sums of every term and view: + sample row ``ra``, - sample row ``rs``
+    (-1: none), in one pass."""
+    if ra >= 0 and rs >= 0:
+        for q in range(td.shape[2]):
+            vd[cc, q] += np.int32(td[ra, cc, q]) - np.int32(td[rs, cc, q])
+            vm[cc, q] += np.int32(tm[ra, cc, q]) - np.int32(tm[rs, cc, q])
+        for i in range(vv.shape[2]):
+            vc[cc, i] += np.int32(vv[ra, cc, i]) - np.int32(vv[rs, cc, i])
+    elif ra >= 0:
+        for q in range(td.shape[2]):
+            vd[cc, q] += np.int32(td[ra, cc, q])
+            vm[cc, q] += np.int32(tm[ra, cc, q])
+        for i in range(vv.shape[2]):
+            vc[cc, i] += np.int32(vv[ra, cc, i])
+    elif rs >= 0:
+        for q in range(td.shape[2]):
+            vd[cc, q] -= np.int32(td[rs, cc, q])
+            vm[cc, q] -= np.int32(tm[rs, cc, q])
+        for i in range(vv.shape[2]):
+            vc[cc, i] -= np.int32(vv[rs, cc, i])
+
+
+@njit
+def _row_step(vd, vm, vc, ca, cs, hd, hm, hc):
+    """Window sums: + column sums ``ca``, - column sums ``cs`` (-1: none), in one pass."""
+    if ca >= 0 and cs >= 0:
+        for q in range(hd.shape[0]):
+            hd[q] += vd[ca, q] - vd[cs, q]
+            hm[q] += vm[ca, q] - vm[cs, q]
+        for i in range(hc.shape[0]):
+            hc[i] += vc[ca, i] - vc[cs, i]
+    elif ca >= 0:
+        for q in range(hd.shape[0]):
+            hd[q] += vd[ca, q]
+            hm[q] += vm[ca, q]
+        for i in range(hc.shape[0]):
+            hc[i] += vc[ca, i]
+    elif cs >= 0:
+        for q in range(hd.shape[0]):
+            hd[q] -= vd[cs, q]
+            hm[q] -= vm[cs, q]
+        for i in range(hc.shape[0]):
+            hc[i] -= vc[cs, i]
+
+
+@njit
+def _count_le(v, t):
+    """Number of entries of ``v`` that are ``<= t``."""
+    c = 0
+    for q in range(v.shape[0]):
+        c += v[q] <= t
+    return c
+
+
+@njit
+def _sum_le(v, t):
+    """Sum (float64) of the entries of ``v`` that are ``<= t``, in four running sums.
+
+    The order of the additions does not change the sum of pair contributions: they are float32 in
+    ``{0} U [1 / (2 _GQ W), 1]`` (``W`` the window's cells), so every one is a multiple of
+    ``2^-43`` while ``W <= 4096`` (radius <= 31), and fewer than ``2^10`` of them add up exactly in
+    float64's 53 bits. The four sums only break the chain of dependent additions.
+    """
+    nt = v.shape[0]
+    s0 = 0.0
+    s1 = 0.0
+    s2 = 0.0
+    s3 = 0.0
+    q = 0
+    while q + 4 <= nt:
+        x0 = v[q]
+        x1 = v[q + 1]
+        x2 = v[q + 2]
+        x3 = v[q + 3]
+        s0 += x0 if x0 <= t else 0.0
+        s1 += x1 if x1 <= t else 0.0
+        s2 += x2 if x2 <= t else 0.0
+        s3 += x3 if x3 <= t else 0.0
+        q += 4
+    while q < nt:
+        x0 = v[q]
+        s0 += x0 if x0 <= t else 0.0
+        q += 1
+    return (s0 + s1) + (s2 + s3)
+
+
+@njit
+def _smallest_mean(v, kb):
+    """Mean of the ``kb`` smallest entries of ``v`` that are ``<= 1`` (at least ``kb`` of them; the
+    entries above 1 mark invalid pairs). Reorders ``v``.
+
+    The same value as :func:`~truortho.core.sgm.cost._combine`'s quickselect, found by bisecting
+    the value range ``(-1, 1]`` until the entries ``<= b`` are exactly the ``kb`` smallest (a
+    counting loop that vectorises), then summing them; ties at the ``kb``-th value that bisection
+    cannot separate end in a quickselect among the few entries of the last interval.
+    """
+    a = -1.0
+    b = 1.0
+    ca = 0
+    cb = _count_le(v, b)
+    it = 0
+    while cb != kb and it < 40:
+        mid = 0.5 * (a + b)
+        cm = _count_le(v, mid)
+        if cm >= kb:
+            b = mid
+            cb = cm
+        else:
+            a = mid
+            ca = cm
+        it += 1
+    if cb == kb:
+        return _sum_le(v, b) / kb
+    s = _sum_le(v, a)
+    nb = 0
+    for q in range(v.shape[0]):
+        x = v[q]
+        if x > a and x <= b:
+            v[nb] = x
+            nb += 1
+    r = kb - ca
+    if r < nb:
+        select_rank(v, 0, nb - 1, r - 1)
+    for j in range(r):
+        s += v[j]
+    return s / kb
 
 
 @pjit
 def _window_cost(td, tm, vv, need, win, box, radius, min_valid, best_k, pi, pj, a, z0, cost):
     """Window sums of the pair terms at the cells with ``need``, and the multi-image cost from them
     (mean of the best pairs, as :func:`~truortho.core.sgm.multi_image_cost`) into
-    ``cost[r, c, a - z0[r, c]]``."""
+    ``cost[r, c, a - z0[r, c]]``.
+
+    The pair contributions of a cell are written for every pair, 2 for the pairs without enough
+    valid samples, and :func:`_smallest_mean` takes the mean of the best; the same cost, to the
+    bit, as compacting the valid ones and quickselecting (:func:`~truortho.core.sgm.cost._combine`),
+    about a fifth less time for this kernel on the battery's tiles.
+    """
     rows, cols, nt = td.shape
     n = vv.shape[2]
     b0, b1, d0, d1 = box[0], box[1], box[2], box[3]
@@ -261,8 +389,8 @@ def _window_cost(td, tm, vv, need, win, box, radius, min_valid, best_k, pi, pj, 
         hd = np.zeros(nt, np.int32)
         hm = np.zeros(nt, np.int32)
         hc = np.zeros(n, np.int32)
-        col = np.empty(nt, np.float32)
-        kbuf = np.empty(nt, np.float32)
+        vok = np.zeros(n, np.uint8)
+        val = np.empty(nt, np.float32)
         for r in range(r0, r1):
             # column sums at every column within `radius` of a searching cell of this row
             for cc in range(d0, d1):
@@ -276,16 +404,14 @@ def _window_cost(td, tm, vv, need, win, box, radius, min_valid, best_k, pi, pj, 
                 if not used:
                     continue
                 if last[cc] == r - 1:
-                    if r + radius < rows:
-                        _add_sample(td, tm, vv, r + radius, cc, 1, vd, vm, vc)
-                    if r - radius - 1 >= 0:
-                        _add_sample(td, tm, vv, r - radius - 1, cc, -1, vd, vm, vc)
+                    ra = r + radius if r + radius < rows else -1
+                    _col_step(td, tm, vv, ra, r - radius - 1, cc, vd, vm, vc)
                 else:
                     vd[cc, :] = 0
                     vm[cc, :] = 0
                     vc[cc, :] = 0
                     for rr in range(max(0, r - radius), min(rows, r + radius + 1)):
-                        _add_sample(td, tm, vv, rr, cc, 1, vd, vm, vc)
+                        _col_step(td, tm, vv, rr, -1, cc, vd, vm, vc)
                 last[cc] = r
             # window sums along runs of searching cells
             prev = -10
@@ -293,48 +419,41 @@ def _window_cost(td, tm, vv, need, win, box, radius, min_valid, best_k, pi, pj, 
                 if need[r, c] == 0:
                     continue
                 if prev == c - 1:
-                    if c + radius < cols:
-                        ca = c + radius
-                        for q in range(nt):
-                            hd[q] += vd[ca, q]
-                            hm[q] += vm[ca, q]
-                        for i in range(n):
-                            hc[i] += vc[ca, i]
-                    if c - radius - 1 >= 0:
-                        cs = c - radius - 1
-                        for q in range(nt):
-                            hd[q] -= vd[cs, q]
-                            hm[q] -= vm[cs, q]
-                        for i in range(n):
-                            hc[i] -= vc[cs, i]
+                    ca = c + radius if c + radius < cols else -1
+                    _row_step(vd, vm, vc, ca, c - radius - 1, hd, hm, hc)
                 else:
                     hd[:] = 0
                     hm[:] = 0
                     hc[:] = 0
                     for cc in range(max(0, c - radius), min(cols, c + radius + 1)):
-                        for q in range(nt):
-                            hd[q] += vd[cc, q]
-                            hm[q] += vm[cc, q]
-                        for i in range(n):
-                            hc[i] += vc[cc, i]
+                        _row_step(vd, vm, vc, cc, -1, hd, hm, hc)
                 prev = c
                 k = _need(_window_cells(r, c, rows, cols, radius), min_valid)
                 nv = 0
                 for i in range(n):
-                    if hc[i] >= k:
-                        nv += 1
+                    ok = hc[i] >= k
+                    vok[i] = ok
+                    nv += ok
                 kk = a - z0[r, c]
                 if nv < 2:
                     cost[r, c, kk] = COST_MAX
                     continue
+                m = 0
                 for q in range(nt):
-                    ok = hc[pi[q]] >= k and hc[pj[q]] >= k and hm[q] >= k
-                    col[q] = min(1.0, hd[q] * scale / hm[q]) if ok else np.nan
-                m = _combine(col, nt, nv, best_k, kbuf)
-                if m < 0.0:
+                    h = hm[q]
+                    ok = (h >= k) & (vok[pi[q]] != 0) & (vok[pj[q]] != 0)
+                    x = np.float32(min(1.0, hd[q] * scale / max(h, 1)))
+                    val[q] = x if ok else np.float32(2.0)
+                    m += ok
+                if m == 0:
                     cost[r, c, kk] = COST_MAX
+                    continue
+                kb = best_k if best_k > 0 else _auto_k(nv)
+                if kb >= m:
+                    mean = _sum_le(val, 1.0) / m
                 else:
-                    cost[r, c, kk] = np.uint16(min(cmax, m * cmax + 0.5))
+                    mean = _smallest_mean(val, kb)
+                cost[r, c, kk] = np.uint16(min(cmax, mean * cmax + 0.5))
 
 
 def slice_scales(sl: np.ndarray) -> tuple[float, float]:

@@ -169,3 +169,34 @@ def test_plane_checks_its_arrays():
         p.plane(0.0, 0.0, RES, Z, need, 0, z0.astype(np.int64), cost)
     with pytest.raises(InputError, match="uint16"):
         p.plane(0.0, 0.0, RES, Z, need, 0, z0, cost.astype(np.int32))
+
+
+def test_smallest_mean_equals_the_quickselect_mean_to_the_bit():
+    """The window cost's mean of the best pairs (bisection) against sgm.cost._combine (quickselect):
+    the same float64 on random pair contributions, with ties, zeros, saturated ones and invalid pairs."""
+    from truortho.core.osgm.sweep import _smallest_mean
+    from truortho.core.sgm.cost import _combine
+
+    rng = np.random.default_rng(11)
+    checked = 0
+    for trial in range(3000):
+        nt = int(rng.integers(1, 130))
+        w = int(rng.choice([9, 25, 49, 121]))  # window cells (radius 1, 2, 3, 5)
+        hd = rng.integers(0, 4 * 127 * w, nt)
+        if trial % 3 == 0:  # ties: few distinct window sums, saturation and zeros
+            hd = rng.choice([0, 1, 7, 127 * w, 2 * 127 * w, 4 * 127 * w], nt)
+        hm = rng.integers(w // 2, w + 1, nt)
+        x = np.minimum(1.0, hd * (1.0 / 254.0) / hm).astype(np.float32)
+        valid = rng.random(nt) < 0.8
+        if not valid.any():
+            continue
+        m = int(valid.sum())
+        kb = int(rng.integers(1, m + 1))
+        col = np.where(valid, x, np.float32(np.nan)).astype(np.float32)
+        want = _combine(col, nt, 2, kb, np.empty(nt, np.float32))
+        v = np.where(valid, x, np.float32(2.0)).astype(np.float32)
+        fn = _smallest_mean.py_func if trial < 100 else _smallest_mean
+        got = fn(v, kb) if kb < m else np.sum(x[valid], dtype=np.float64) / m
+        assert got == want, (trial, nt, kb, m)
+        checked += 1
+    assert checked > 2500
