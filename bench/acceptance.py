@@ -33,6 +33,10 @@ Per scene, against the exact truth on the truth DSM's grid (the scene extent at 
   cells seen by no image (truth, eroded by one cell) that carry a colour ("wrong fill"), and (not a
   goal) the wrong colours 1-6 cells from the outlines (``ghosting_beyond_outline``: leaning or
   double-mapped buildings, without the outline's own placement that ``ghosting`` also counts);
+* the true ortho's colour edges (``TrueOrthoConfig.edge_colour``, default ``checked``; not a goal):
+  the ghosting on the truth and the OSGM DSM also with them off and in the mode for exact surfaces
+  (``ortho_truth_edge_off``, ``ortho_truth_edge_surface``, ``ortho_osgm_edge_off``,
+  ``ortho_osgm_edge_surface``);
 * a calibration of the ghosting goal (not a goal): the truth DSM with every outline one cell off
   (``truth_shift1``, moved one cell east), its DSM figures, and the ghosting of the true ortho on
   it (``ortho_shift1``).
@@ -422,18 +426,24 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     write_raster(os.path.join(folder, "dsm_shift1.tif"), shifted.astype(np.float32), grid, nodata=-9999.0)
     row["truth_shift1"] = dsm_figures(shifted, truth, seen2, edge, gsd)
     log(f"  truth DSM one cell off: {_fmt(row['truth_shift1'])}")
+    # the colour edges (TrueOrthoConfig.edge_colour, default "checked") also without them, and in the
+    # mode for exact surfaces
     runs = (
-        ("ortho_truth", "dsm.tif", True),
-        ("ortho_conventional", "dsm.tif", False),
-        ("ortho_osgm", "osgm.tif", True),
-        ("ortho_filtered", "osgm_filtered.tif", True),
-        ("ortho_shift1", "dsm_shift1.tif", True),
+        ("ortho_truth", "dsm.tif", True, {}),
+        ("ortho_conventional", "dsm.tif", False, {}),
+        ("ortho_osgm", "osgm.tif", True, {}),
+        ("ortho_filtered", "osgm_filtered.tif", True, {}),
+        ("ortho_shift1", "dsm_shift1.tif", True, {}),
+        ("ortho_truth_edge_off", "dsm.tif", True, {"edge_colour": "off"}),
+        ("ortho_truth_edge_surface", "dsm.tif", True, {"edge_colour": "surface"}),
+        ("ortho_osgm_edge_off", "osgm.tif", True, {"edge_colour": "off"}),
+        ("ortho_osgm_edge_surface", "osgm.tif", True, {"edge_colour": "surface"}),
     )
-    for key, surface, vis in runs:
+    for key, surface, vis, changes in runs:
         path = os.path.join(folder, f"{key}.tif")
         t = time.perf_counter()
         occ = os.path.join(folder, f"{key}_occ.tif")
-        ocfg = TrueOrthoConfig(resolution=res, visibility=vis, extent=scene.extent_world())
+        ocfg = TrueOrthoConfig(resolution=res, visibility=vis, extent=scene.extent_world(), **changes)
         true_ortho(
             scene.orientation, os.path.join(folder, surface), path, None, occ, config=ocfg, image_root=folder
         )
@@ -562,6 +572,11 @@ def summary(rows: list[dict]) -> list[str]:
         "ortho_osgm.relative_dE",
         "ortho_osgm.wrong_fill",
         "ortho_conventional.ghosting",
+        "ortho_truth_edge_off.ghosting",
+        "ortho_truth_edge_surface.ghosting",
+        "ortho_osgm_edge_off.ghosting",
+        "ortho_osgm_edge_surface.ghosting",
+        "ortho_osgm_edge_off.ghosting_beyond_outline",
         "truth_shift1.edge3",
         "truth_shift1.flat3",
         "ortho_shift1.ghosting",

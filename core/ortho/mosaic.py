@@ -197,6 +197,7 @@ class MosaicParams:
     discontinuity: float = 0.5
     blend_width: int = 5
     sweeps: int = 8
+    edge_colour: str = "off"  # :data:`~.edgecolour.EDGE_COLOURS`
 
 
 @dataclass
@@ -440,6 +441,12 @@ def mosaic_tile(
     values = np.empty((bands, rows, cols), np.float32)
     _blend(w, colours, values)
     alpha = labels >= 0
+    if params.edge_colour != "off" and bands == 3:
+        from .edgecolour import surface_edge_colour
+
+        h0 = max(float(params.discontinuity), 2.0 * float(res))  # the selection's (select_labels)
+        scale = float(value_scale(store.dtype))
+        values = surface_edge_colour(values, alpha, views.heights, h0, scale, params.edge_colour == "checked")
     glabel = np.where(alpha, views.cands[np.clip(labels, 0, K - 1)], -1).astype(np.int64)
     return TileMosaic(values, alpha, glabel, occl)
 

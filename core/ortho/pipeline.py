@@ -138,6 +138,14 @@ class TrueOrthoConfig:
         4:2:2, read from the file header) get their colour edges restored from the brightness
         before they are sampled at full resolution (:mod:`truortho.core.chroma`): without it the
         decoder's smeared colour paints roof colours beside every outline.
+    edge_colour : {"off", "checked", "surface"}
+        The colour (not the brightness) of the cells within 3 cells of the surface's height steps
+        taken from the cells of their own surface beyond the steps (:mod:`.edgecolour`): removes
+        the colour fringe that JPEG leaves along roof outlines where the brightness cannot.
+        ``checked`` (default): only where the cell's colour is already nearer its own surface's
+        than the other side's, so that a DSM whose outlines are a cell or two off does not get
+        roof colours painted on the ground. ``surface``: every such cell, for surfaces whose
+        outlines are exact (LiDAR DSM, building model). RGB only.
     color_cells : int
         Cells of the decimated grid used to estimate the colour correction.
     workers : int
@@ -198,6 +206,7 @@ class TrueOrthoConfig:
     top_views: int = 8
     image_cache_mb: int = 1024
     restore_chroma: bool = True
+    edge_colour: str = "checked"
     color_cells: int = 60_000
     workers: int = 2
     cog: bool = True
@@ -244,6 +253,10 @@ class TrueOrthoConfig:
                 bad(name, "must not be negative")
         if self.extent is not None and len(self.extent) != 4:
             bad("extent", "expected (xmin, ymin, xmax, ymax)")
+        from .edgecolour import EDGE_COLOURS
+
+        if self.edge_colour not in EDGE_COLOURS:
+            bad("edge_colour", f"expected one of {', '.join(EDGE_COLOURS)}")
         if self.compression not in ORTHO_COMPRESSIONS:
             bad("compression", f"expected one of {', '.join(ORTHO_COMPRESSIONS)}")
         if self.compression == "jpeg" and not self.cog:
@@ -722,7 +735,13 @@ def run_mosaic(
     )
     tiles, batches = sched.tiles, sched.batches
     params = MosaicParams(
-        cfg.edge_penalty, cfg.smoothness, cfg.contrast, cfg.discontinuity, cfg.blend_width, cfg.sweeps
+        cfg.edge_penalty,
+        cfg.smoothness,
+        cfg.contrast,
+        cfg.discontinuity,
+        cfg.blend_width,
+        cfg.sweeps,
+        cfg.edge_colour,
     )
     workers = max(1, int(cfg.workers))
     stats: dict = {}

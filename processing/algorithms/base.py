@@ -161,6 +161,29 @@ class TruOrthoAlgorithm(QgsProcessingAlgorithm):
             advanced=True,
         )
 
+    def add_edge_colour(self) -> None:
+        """The advanced EDGE_COLOUR parameter of the algorithms that make a true orthophoto (options in
+        the order of :data:`~truortho.core.ortho.edgecolour.EDGE_COLOURS`)."""
+        self.add(
+            QgsProcessingParameterEnum(
+                "EDGE_COLOUR",
+                tr("Colour edges from the surface's height steps"),
+                options=[
+                    tr("off"),
+                    tr("checked: where the photos agree with the surface"),
+                    tr("surface: at every height step (exact surfaces: LiDAR, building models)"),
+                ],
+                defaultValue=self.default("EDGE_COLOUR"),
+            ),
+            advanced=True,
+        )
+
+    def edge_colour_choice(self, parameters, context) -> str:
+        """EDGE_COLOUR as a :attr:`~truortho.core.ortho.pipeline.TrueOrthoConfig.edge_colour` mode."""
+        from ...core.ortho.edgecolour import EDGE_COLOURS
+
+        return EDGE_COLOURS[self.parameterAsEnum(parameters, "EDGE_COLOUR", context)]
+
     def add_executor(self) -> None:
         """The advanced EXECUTOR and SCHEDULER_ADDRESS parameters of the tiled algorithms."""
         import os

@@ -37,6 +37,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
     RESOLUTION = "RESOLUTION"
     REUSE_ORIENTATION = "REUSE_ORIENTATION"
     RESTORE_CHROMA = "RESTORE_CHROMA"
+    EDGE_COLOUR = "EDGE_COLOUR"
     EXECUTOR = "EXECUTOR"
     SCHEDULER_ADDRESS = "SCHEDULER_ADDRESS"
     OUTPUT_FOLDER = "OUTPUT_FOLDER"
@@ -44,6 +45,10 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
         RESOLUTION: FromConfig("workflow.WorkflowConfig", "resolution", none=0.0),
         REUSE_ORIENTATION: FromConfig("workflow.WorkflowConfig", "reuse_orientation"),
         RESTORE_CHROMA: FromConfig("ortho.pipeline.TrueOrthoConfig", "restore_chroma"),
+        # EDGE_COLOUR's options are listed in the order of EDGE_COLOURS
+        EDGE_COLOUR: FromConfig(
+            "ortho.pipeline.TrueOrthoConfig", "edge_colour", "ortho.edgecolour.EDGE_COLOURS"
+        ),
         EXECUTOR: executor_default("workflow.WorkflowConfig"),
     }
     # outputs (files named in truortho.core.workflow.PRODUCTS)
@@ -89,6 +94,7 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
             )
         )
         self.add_restore_chroma()
+        self.add_edge_colour()
         self.add_executor()
         self.add(QgsProcessingParameterFolderDestination(self.OUTPUT_FOLDER, tr("Output folder")))
         names = {
@@ -147,7 +153,8 @@ class PipelineAlgorithm(TruOrthoAlgorithm):
             camera_file=self.parameterAsFile(parameters, self.CAMERA, context) or None,
             reuse_orientation=reuse,
             ortho=TrueOrthoConfig(
-                restore_chroma=self.parameterAsBool(parameters, self.RESTORE_CHROMA, context)
+                restore_chroma=self.parameterAsBool(parameters, self.RESTORE_CHROMA, context),
+                edge_colour=self.edge_colour_choice(parameters, context),
             ),
             # one executor for OSGM, the DSM filter and the true orthophoto (made and closed by run_workflow)
             executor=executor_kind,

@@ -50,6 +50,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
     COLOR_CORRECTION = "COLOR_CORRECTION"
     VIGNETTING = "VIGNETTING"
     RESTORE_CHROMA = "RESTORE_CHROMA"
+    EDGE_COLOUR = "EDGE_COLOUR"
     MAX_VIEW_ANGLE = "MAX_VIEW_ANGLE"
     BLEND_WIDTH = "BLEND_WIDTH"
     TILE_SIZE = "TILE_SIZE"
@@ -67,6 +68,10 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
         COLOR_CORRECTION: FromConfig("ortho.pipeline.TrueOrthoConfig", "color_correction"),
         VIGNETTING: FromConfig("ortho.pipeline.TrueOrthoConfig", "vignetting"),
         RESTORE_CHROMA: FromConfig("ortho.pipeline.TrueOrthoConfig", "restore_chroma"),
+        # EDGE_COLOUR's options are listed in the order of EDGE_COLOURS
+        EDGE_COLOUR: FromConfig(
+            "ortho.pipeline.TrueOrthoConfig", "edge_colour", "ortho.edgecolour.EDGE_COLOURS"
+        ),
         MAX_VIEW_ANGLE: FromConfig("ortho.pipeline.TrueOrthoConfig", "max_view_angle"),
         BLEND_WIDTH: FromConfig("ortho.pipeline.TrueOrthoConfig", "blend_width"),
         TILE_SIZE: FromConfig("ortho.pipeline.TrueOrthoConfig", "tile_size"),
@@ -117,6 +122,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             )
         )
         self.add_restore_chroma()
+        self.add_edge_colour()
         self.add(
             QgsProcessingParameterNumber(
                 self.MAX_VIEW_ANGLE,
@@ -220,6 +226,7 @@ class TrueOrthoAlgorithm(TruOrthoAlgorithm):
             color_correction=self.parameterAsBool(parameters, self.COLOR_CORRECTION, context),
             vignetting=self.parameterAsBool(parameters, self.VIGNETTING, context),
             restore_chroma=self.parameterAsBool(parameters, self.RESTORE_CHROMA, context),
+            edge_colour=self.edge_colour_choice(parameters, context),
             max_view_angle=self.parameterAsDouble(parameters, self.MAX_VIEW_ANGLE, context),
             blend_width=self.parameterAsInt(parameters, self.BLEND_WIDTH, context),
             tile_size=self.parameterAsInt(parameters, self.TILE_SIZE, context),

@@ -8,6 +8,17 @@ from __future__ import annotations
 
 from ..i18n import tr
 
+#: Help of EDGE_COLOUR, the same for every algorithm that makes a true orthophoto.
+_EDGE_COLOUR_HELP = (
+    "JPEG photos smear colour over a few pixels across roof outlines, where roof and ground are about "
+    "as bright (the brightness cannot restore it). Within 3 cells of the surface's height steps, a "
+    "cell's colour (not its brightness) can be taken from the cells of its own surface farther from "
+    "the step. checked (the default): only where the cell's colour is already nearer its own "
+    "surface's than the other side's, so that a DSM from image matching, whose outlines may be a cell "
+    "or two off, does not get roof colours painted on the ground. surface: every such cell, for a "
+    "surface whose outlines are exact (a LiDAR DSM, a building model). off: the mosaic's colours as "
+    "sampled. RGB images only."
+)
 #: Help of SCHEDULER_ADDRESS, the same for every tiled algorithm.
 _SCHEDULER_HELP = (
     "Address of the Dask scheduler for EXECUTOR = scheduler: tls://host:8786, "
@@ -177,6 +188,7 @@ HELP: dict[str, dict] = {
             "(4:2:0 or 4:2:2, read from each file's header), so colours smear across building outlines. "
             "When on, the colour edges of such images are restored from the brightness before they are "
             "sampled at full resolution. Other images are not changed.",
+            "EDGE_COLOUR": _EDGE_COLOUR_HELP,
             "EXECUTOR": "Where the tiles of dense matching, DSM filtering and the true orthophoto are "
             "computed, by one executor for the three stages (a local cluster starts once); the products "
             "are identical with every choice. inprocess: in QGIS's process, one tile after the other on "
@@ -311,6 +323,7 @@ HELP: dict[str, dict] = {
             "(4:2:0 or 4:2:2, read from each file's header), so colours smear across building outlines. "
             "When on, the colour edges of such images are restored from the brightness before they are "
             "sampled at full resolution. Other images are not changed.",
+            "EDGE_COLOUR": _EDGE_COLOUR_HELP,
             "MAX_VIEW_ANGLE": "Largest off-nadir angle of the viewing ray (degrees) for an image to texture "
             "a cell; also bounds how far outside a tile occluders are searched.",
             "BLEND_WIDTH": "Width of the feathering across seamlines, in cells (0 = hard seams).",

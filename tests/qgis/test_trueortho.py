@@ -219,7 +219,8 @@ def test_trueortho_restore_chroma_parameter(truortho_provider, tmp_path):
     for on in (False, True):
         out = tmp_path / f"ortho_{int(on)}.tif"
         params = {"ORIENTATION": str(root / "orientation.json"), "SURFACE": str(root / "dsm.tif")}
-        run({**params, "RESTORE_CHROMA": on, "COLOR_CORRECTION": False, "OUTPUT": str(out)})
+        # EDGE_COLOUR off: the fringe it removes is what this test measures
+        run({**params, "RESTORE_CHROMA": on, "COLOR_CORRECTION": False, "EDGE_COLOUR": 0, "OUTPUT": str(out)})
         a, grid, _ = read_raster(out, band=None)
         truth, _ = scene.orthophoto(grid.res)
         roofs = ev.building_mask(scene, grid)
@@ -228,3 +229,38 @@ def test_trueortho_restore_chroma_parameter(truortho_provider, tmp_path):
         x = np.moveaxis(a[:3], 0, -1)[band]
         err[on] = float(ev.delta_e(x[None], truth[band][None]).mean())
     assert err[True] < 0.9 * err[False], err
+
+
+def test_trueortho_edge_colour_parameter(truortho_provider, scene_dir, tmp_path):
+    """EDGE_COLOUR (advanced; off | checked | surface, default checked; also in truortho:pipeline)
+    reaches the mosaic: against off, the colours change only near the surface's height steps, no fewer
+    cells with surface than with checked (as many on these sharp PNG photos), and there the
+    brightness stays (up to rounding, and clipping where a channel saturates)."""
+    from qgis.core import QgsApplication, QgsProcessingParameterDefinition
+    from scipy.ndimage import maximum_filter, minimum_filter
+
+    from truortho.core.ortho.edgecolour import REACH
+    from truortho.core.rasterio_io import read_raster
+
+    for alg_id in ("truortho:trueortho", "truortho:pipeline"):
+        p = QgsApplication.processingRegistry().algorithmById(alg_id).parameterDefinition("EDGE_COLOUR")
+        assert [o.split(":")[0] for o in p.options()] == ["off", "checked", "surface"], alg_id
+        assert p.defaultValue() == 1 and p.flags() & QgsProcessingParameterDefinition.FlagAdvanced
+    _, root = scene_dir
+    a = {}
+    for mode in (0, 1, 2):
+        out = tmp_path / f"ortho_{mode}.tif"
+        params = {"ORIENTATION": str(root / "orientation.json"), "SURFACE": str(root / "dsm.tif")}
+        run({**params, "EDGE_COLOUR": mode, "OUTPUT": str(out)})
+        a[mode], _, _ = read_raster(out, band=None)
+    h, _, _ = read_raster(root / "dsm.tif")
+    steps = (maximum_filter(h, 3) - minimum_filter(h, 3)) > 0.5
+    near = maximum_filter(steps, 2 * (REACH + 2) + 1)
+    changed = {m: np.any(a[m][:3] != a[0][:3], axis=0) for m in (1, 2)}
+    assert 50 < changed[1].sum() <= changed[2].sum()
+    luma = lambda x: np.moveaxis(x[:3].astype(float), 0, -1) @ np.array([0.299, 0.587, 0.114])  # noqa: E731
+    for m in (1, 2):
+        assert not (changed[m] & ~near).any()
+        d = np.abs(luma(a[m]) - luma(a[0]))[changed[m]]
+        assert np.percentile(d, 95) <= 1.0, np.percentile(d, [50, 95, 100])
+        assert np.array_equal(a[m][3], a[0][3])
