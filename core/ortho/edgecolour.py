@@ -55,6 +55,10 @@ EDGE_COLOURS = ("off", "checked", "surface")
 
 @njit
 def _kernel(y, cb, cr, seg, alpha, dstep, reach, win, sy, gate, out_b, out_r):
+    """``out_b``, ``out_r``: Cb, Cr of every cell within ``reach`` of a step (``dstep``, distance to
+    the nearest step cell) replaced by its own segment's weighted mean over the ``(2 win + 1)^2``
+    window (with ``gate``: only where the cell's colour is nearer that mean than the other
+    segments'); every other cell's copied."""
     rows, cols = y.shape
     s2 = (win * win) / 4.0  # spatial spread: half the window
     for i in range(rows):
@@ -118,7 +122,16 @@ def surface_edge_colour(
 
     ``alpha`` (rows, cols): cells with a colour; ``heights`` (rows, cols): the surface on the same
     cells (NaN: none); ``step``: the smallest height difference (m) between two neighbouring cells
-    that separates two surfaces; ``scale``: the value range (255 for 8-bit data).
+    that separates two surfaces; ``scale``: the value range (255 for 8-bit data), which the
+    brightness weight is relative to; ``checked``: replace a cell's colour only when it is nearer
+    its own surface's colour (the weighted mean) than the other surfaces' in the window (the same
+    weights without the brightness term): the photo must put the cell on the side the heights do.
+
+    Raises
+    ------
+    InputError
+        ``values`` not (3, rows, cols), ``alpha`` or ``heights`` of another shape, ``step`` or
+        ``scale`` not a finite number > 0.
     """
     v = np.asarray(values, np.float64)
     if v.ndim != 3 or v.shape[0] != 3:
