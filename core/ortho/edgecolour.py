@@ -36,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
+from ..imagery import REC601
 from ..jit import njit
 
 #: Cells from a height step whose colour is replaced: the smear of 4:2:0 JPEG colour after the
@@ -54,13 +55,13 @@ EDGE_COLOURS = ("off", "checked", "surface")
 
 
 @njit
-def _kernel(y, cb, cr, seg, alpha, dstep, reach, win, sy, gate, out_b, out_r):
+def _kernel(y, cb, cr, seg, alpha, dstep, reach, space, sy, gate, out_b, out_r):
     """``out_b``, ``out_r``: Cb, Cr of every cell within ``reach`` of a step (``dstep``, distance to
     the nearest step cell) replaced by its own segment's weighted mean over the ``(2 win + 1)^2``
-    window (with ``gate``: only where the cell's colour is nearer that mean than the other
-    segments'); every other cell's copied."""
+    window of the spatial weights ``space`` (with ``gate``: only where the cell's colour is nearer
+    that mean than the other segments'); every other cell's copied."""
     rows, cols = y.shape
-    s2 = (win * win) / 4.0  # spatial spread: half the window
+    win = space.shape[0] // 2
     for i in range(rows):
         for j in range(cols):
             out_b[i, j] = cb[i, j]
@@ -84,7 +85,7 @@ def _kernel(y, cb, cr, seg, alpha, dstep, reach, win, sy, gate, out_b, out_r):
                     f = min(1.0, dstep[ii, jj] / reach)
                     if f <= 0.0:
                         continue
-                    ws = f * f * np.exp(-0.5 * (di * di + dj * dj) / s2)
+                    ws = f * f * space[di + win, dj + win]
                     if seg[ii, jj] != seg[i, j]:
                         ob += ws * cb[ii, jj]
                         orr += ws * cr[ii, jj]
@@ -153,27 +154,27 @@ def surface_edge_colour(
     seg = segments(np.where(a, h, np.nan), float(step))
     # the steps: cells with a 4-neighbour on another segment (neither without a surface)
     edge = np.zeros(shape, bool)
-    for ax in (0, 1):
-        lo = [slice(None)] * 2
-        hi = [slice(None)] * 2
-        lo[ax] = slice(None, -1)
-        hi[ax] = slice(1, None)
-        a0, a1 = seg[tuple(lo)], seg[tuple(hi)]
-        d = (a0 >= 0) & (a1 >= 0) & (a0 != a1)
-        edge[tuple(lo)] |= d
-        edge[tuple(hi)] |= d
+    across = (seg[:, 1:] != seg[:, :-1]) & (seg[:, 1:] >= 0) & (seg[:, :-1] >= 0)
+    down = (seg[1:, :] != seg[:-1, :]) & (seg[1:, :] >= 0) & (seg[:-1, :] >= 0)
+    edge[:, 1:] |= across
+    edge[:, :-1] |= across
+    edge[1:, :] |= down
+    edge[:-1, :] |= down
     out = v.astype(np.float32)
     if not edge.any():
         return out
     dstep = distance_transform_edt(~edge)
     r, g, b = v
-    y = 0.299 * r + 0.587 * g + 0.114 * b
+    y = REC601[0] * r + REC601[1] * g + REC601[2] * b
     cb = -0.168736 * r - 0.331264 * g + 0.5 * b
     cr = 0.5 * r - 0.418688 * g - 0.081312 * b
     ob = np.empty_like(cb)
     orr = np.empty_like(cr)
+    # spatial weight of the window's cells, spread half the window (computed once, not per cell)
+    d2 = np.add.outer(np.arange(-WINDOW, WINDOW + 1) ** 2, np.arange(-WINDOW, WINDOW + 1) ** 2)
+    space = np.exp(-0.5 * d2 / ((WINDOW * WINDOW) / 4.0))
     sy = SIGMA_LUMA * float(scale)
-    _kernel(y, cb, cr, seg, a, dstep, float(REACH), int(WINDOW), sy, bool(checked), ob, orr)
+    _kernel(y, cb, cr, seg, a, dstep, float(REACH), space, sy, bool(checked), ob, orr)
     zone = (ob != cb) | (orr != cr)  # the cells whose colour the kernel replaced
     new = (y + 1.402 * orr, y - 0.344136 * ob - 0.714136 * orr, y + 1.772 * ob)
     for k in range(3):
