@@ -26,6 +26,7 @@ from ..errors import FormatError, InputError
 from ..imagery import REC601, level_size, read_image_level, read_level_window
 from ..jit import njit
 from .color import ColorCorrection, value_scale
+from .edgecolour import EDGE_COLOURS, surface_edge_colour
 from .seams import feather_weights
 from .select import data_costs, select_labels
 from .views import TileViews
@@ -198,6 +199,13 @@ class MosaicParams:
     blend_width: int = 5
     sweeps: int = 8
     edge_colour: str = "off"  # :data:`~.edgecolour.EDGE_COLOURS`
+
+    def __post_init__(self) -> None:
+        # TrueOrthoConfig checks its own copy; code that builds the parameters directly must not get
+        # ``surface`` for a misspelt mode
+        if self.edge_colour not in EDGE_COLOURS:
+            want = ", ".join(EDGE_COLOURS)
+            raise InputError(f"MosaicParams.edge_colour: expected one of {want}, got {self.edge_colour!r}")
 
 
 @dataclass
@@ -442,8 +450,6 @@ def mosaic_tile(
     _blend(w, colours, values)
     alpha = labels >= 0
     if params.edge_colour != "off" and bands == 3:
-        from .edgecolour import surface_edge_colour
-
         h0 = max(float(params.discontinuity), 2.0 * float(res))  # the selection's (select_labels)
         scale = float(value_scale(store.dtype))
         values = surface_edge_colour(values, alpha, views.heights, h0, scale, params.edge_colour == "checked")

@@ -125,6 +125,16 @@ def test_bad_input_is_named():
         surface_edge_colour(v, ok, np.zeros((4, 5)), 0.5, float("nan"))
 
 
+def test_mosaic_params_name_an_unknown_mode():
+    """Code that builds the mosaic's parameters itself gets an error, not ``surface``, for a typo."""
+    from truortho.core.ortho.mosaic import MosaicParams
+
+    with pytest.raises(InputError, match="edge_colour.*off, checked, surface.*'checkd'"):
+        MosaicParams(edge_colour="checkd")
+    assert MosaicParams().edge_colour == "off"
+    assert MosaicParams(edge_colour="surface").edge_colour == "surface"
+
+
 def test_pipeline_on_jpeg_photos_with_the_exact_dsm(tmp_path):
     """``edge_colour`` reaches the mosaic: on 4:2:0 JPEG photos (quality 75) with the truth DSM, fewer
     cells of the 2-cell band around the outlines are more than dE 25 off the truth and their mean dE
