@@ -594,6 +594,24 @@ def test_edge_decision_takes_wall_heights_and_holes_outright():
     assert not fill[2] and not switch[2]
 
 
+def test_edge_heights_off_their_side_are_listed():
+    """Step 7 of core/osgm/edges.py competes only cells that keep their side but lie more than tol
+    from its candidate: not holes, not the cells switched or filled, not the wall heights, and only
+    with a pair of views on their side."""
+    from truortho.core.osgm.edges import _off_side
+
+    tol = 0.2
+    zc = np.array([9.5, 9.9, np.nan, 9.5, 5.0, 9.5, 0.5, 9.5])
+    side_height = np.array([10.0, 10.0, 10.0, 10.0, 10.0, 10.0, 0.0, np.nan])
+    pairs = np.array([3, 3, 3, 3, 3, 0, 2, 3])
+    decided = np.array([False, False, False, True, False, False, False, False])
+    between = np.array([False, False, False, False, True, False, False, False])
+    got = _off_side(zc, side_height, pairs, decided, between, tol)
+    # 0: 0.5 off -> listed; 1: within tol; 2: hole; 3: switched; 4: on the wall; 5: no pair of views;
+    # 6: ground 0.5 above its side -> listed; 7: no candidate
+    assert got.tolist() == [True, False, False, False, False, False, True, False]
+
+
 def _ray_free_reference(z, r, c, h, x0, y0, res, C, tol, near):
     """The visibility march of core/osgm/edges.py point by point, without skipping blocks."""
     rows, cols = z.shape
