@@ -29,6 +29,10 @@ import os
 import numpy as np
 
 from .errors import InputError
+from .imagery import REC601 as _Y
+from .imagery import REC601_CB as _CB
+from .imagery import REC601_CR as _CR
+from .imagery import REC601_INV as _INV
 from .jit import njit, pjit, prange
 
 #: Spread of the luma difference (0-255; 3 % of the range) over which a neighbour's weight falls by
@@ -89,9 +93,9 @@ def jpeg_chroma_subsampling(path) -> tuple[int, int] | None:
 
 @njit
 def _ycc(r, g, b):
-    y = 0.299 * r + 0.587 * g + 0.114 * b
-    cb = 128.0 - 0.168736 * r - 0.331264 * g + 0.5 * b
-    cr = 128.0 + 0.5 * r - 0.418688 * g - 0.081312 * b
+    y = _Y[0] * r + _Y[1] * g + _Y[2] * b
+    cb = 128.0 + _CB[0] * r + _CB[1] * g + _CB[2] * b
+    cr = 128.0 + _CR[0] * r + _CR[1] * g + _CR[2] * b
     return y, cb, cr
 
 
@@ -153,7 +157,7 @@ def _filter(y, cb, cr, flat, rx, ry, lut, space, out):
             else:
                 vb = cb[i, j] - 128.0
                 vr = cr[i, j] - 128.0
-            rgb = (y0 + 1.402 * vr, y0 - 0.344136 * vb - 0.714136 * vr, y0 + 1.772 * vb)
+            rgb = (y0 + _INV[0] * vr, y0 - _INV[1] * vb - _INV[2] * vr, y0 + _INV[3] * vb)
             for k in range(3):
                 out[i, j, k] = np.uint8(min(max(rgb[k] + 0.5, 0.0), 255.0))
 

@@ -38,6 +38,11 @@ from .errors import FormatError, InputError, MissingFileError
 _RASTERIO_EXT = (".tif", ".tiff", ".vrt", ".jp2")
 #: Rec. 601 luma weights for R, G, B.
 REC601 = (0.299, 0.587, 0.114)
+#: Rec. 601 (JPEG, JFIF) colour differences from R, G, B: Cb and Cr (without the 128 offset).
+REC601_CB = (-0.168736, -0.331264, 0.5)
+REC601_CR = (0.5, -0.418688, -0.081312)
+#: Their inverse: ``R = Y + a Cr``, ``G = Y - b Cb - c Cr``, ``B = Y + d Cb`` with ``(a, b, c, d)``.
+REC601_INV = (1.402, 0.344136, 0.714136, 1.772)
 
 
 @dataclass(frozen=True)

@@ -36,7 +36,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import InputError
-from ..imagery import REC601
+from ..imagery import REC601, REC601_CB, REC601_CR, REC601_INV
 from ..jit import njit
 
 #: Cells from a height step whose colour is replaced: the smear of 4:2:0 JPEG colour after the
@@ -166,8 +166,8 @@ def surface_edge_colour(
     dstep = distance_transform_edt(~edge)
     r, g, b = v
     y = REC601[0] * r + REC601[1] * g + REC601[2] * b
-    cb = -0.168736 * r - 0.331264 * g + 0.5 * b
-    cr = 0.5 * r - 0.418688 * g - 0.081312 * b
+    cb = REC601_CB[0] * r + REC601_CB[1] * g + REC601_CB[2] * b
+    cr = REC601_CR[0] * r + REC601_CR[1] * g + REC601_CR[2] * b
     ob = np.empty_like(cb)
     orr = np.empty_like(cr)
     # spatial weight of the window's cells, spread half the window (computed once, not per cell)
@@ -176,7 +176,8 @@ def surface_edge_colour(
     sy = SIGMA_LUMA * float(scale)
     _kernel(y, cb, cr, seg, a, dstep, float(REACH), space, sy, bool(checked), ob, orr)
     zone = (ob != cb) | (orr != cr)  # the cells whose colour the kernel replaced
-    new = (y + 1.402 * orr, y - 0.344136 * ob - 0.714136 * orr, y + 1.772 * ob)
+    ir, igb, igr, ib = REC601_INV
+    new = (y + ir * orr, y - igb * ob - igr * orr, y + ib * ob)
     for k in range(3):
         out[k][zone] = new[k][zone]
     return out
