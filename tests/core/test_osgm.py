@@ -1100,6 +1100,44 @@ def test_a_pass_with_its_own_trend_follows_a_weak_roof_down_to_its_eaves():
             aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, passes=bad)
 
 
+def test_trend_from_a_lighter_first_pass_keeps_a_ridge_and_its_eaves():
+    """A tent roof (0.6 levels per cell up to a ridge, then down) with a weak data term: the first
+    aggregation, whose result gives the trend, pays a fraction :data:`TREND_P1` of P1, so the slopes
+    it hands on are less flattened than with the whole P1 (its eaves and ridge closer to the truth
+    over four noise draws), and the ground stays as it was."""
+    from truortho.core.osgm.matching import TREND_P1, TileParams, aggregate_with_trend
+    from truortho.core.sgm import select, valid_cells
+
+    assert 0.0 < TREND_P1 < 1.0
+    rows, cols, nd = 40, 90, 90
+    c = np.arange(cols)
+    roof = (c >= 20) & (c < 70)
+    true = np.broadcast_to(np.where(roof, 40 + 0.6 * np.minimum(c - 20, 69 - c), 5.0)[None, :], (rows, cols))
+    gain = np.where(roof, 10, 30)[None, :, None]
+    params = TileParams(radius=2, measure="gradient", p1=256, p2=2048, paths=16, uniqueness=0.99,
+                        max_images=12, max_view_angle=50.0, median=1, slope_max=2)  # fmt: skip
+    z0 = np.zeros((rows, cols), np.int32)
+    err: dict[float, list] = {1.0: [], TREND_P1: []}
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        k = np.arange(nd)[None, None, :]
+        cost = 300 + gain * np.abs(k - true[..., None]) + rng.normal(0, 20, (rows, cols, nd))
+        cost = np.clip(cost, 0, 1023).astype(np.uint16)
+        valid = valid_cells(cost)
+        for f in err:
+            S = aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, p1_factor=f)
+            level, _ = select(S, z0, 0.99, valid=valid)
+            err[f].append(np.abs(level - true)[5:-5])
+    e1, ef = np.stack(err[1.0]), np.stack(err[TREND_P1])
+    assert np.nanmean(ef[..., roof]) < 0.92 * np.nanmean(e1[..., roof])
+    assert np.nanmean(ef[..., 20:26]) < 0.9 * np.nanmean(e1[..., 20:26])  # the eaves
+    assert np.nanmean(ef[..., 40:50]) < np.nanmean(e1[..., 40:50])  # the ridge
+    assert np.nanmean(ef[..., ~roof]) < 0.1 and np.nanmean(e1[..., ~roof]) < 0.1  # the ground
+    for bad in (0.0, 1.5, True, "0.5"):
+        with pytest.raises(InputError, match="p1_factor must be a number in"):
+            aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, p1_factor=bad)
+
+
 def test_slope_trend_rejects_bad_input():
     from truortho.core.osgm.matching import slope_trend
 
