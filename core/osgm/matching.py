@@ -175,10 +175,9 @@ def aggregate_with_trend(cost, params: TileParams, z0, guide, trend, valid, z_ba
     The first aggregations pay only ``p1_factor`` (:data:`TREND_P1`) of P1; the last, whose heights
     the tile keeps, the whole P1. With the whole P1 the first result was still flattened where the
     data term is weak against P1 (on seed 2026 scene 9 a hip roof's ridge at 22.0 m read 21.2 m
-    flat over 24 cells, where the truth spans 21.3-22.0 m, and a ramp from a roof's eaves stayed
-    flat over its lowest 6-8 cells), and its trend handed that on. With P1 / 4 alone the ridge was
-    found (the data term knows it), but the ground's NMAD rose (scene 9 0.24 -> 0.38 GSD); as the
-    first pass only, its slopes reach the final aggregation through the trend, which stays off on
+    flat over 24 cells, where the truth spans 21.3-22.0 m), and its trend handed that on. With
+    P1 / 4 alone the ridge was found (the data term knows it), but the ground's NMAD rose (scene 9
+    0.24 -> 0.38 GSD); as the first pass only, its slopes reach the final aggregation through the trend, which stays off on
     flat ground (:data:`TREND_MIN_SLOPE`). Measured with ``bench/osgm_battery.py`` against the whole
     P1: factor 1/2 on master seeds 2026 and 7, edge3 up on 17 of 24 scenes (up to 2.1 points: seed
     2026 scene 2 82.6 -> 84.7 %), down on 6 by at most 0.14; seed 2026 scene 9 flat3 96.9 -> 97.1 %.
