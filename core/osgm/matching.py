@@ -174,19 +174,19 @@ def aggregate_with_trend(cost, params: TileParams, z0, guide, trend, valid, z_ba
 
     The first aggregations pay only ``p1_factor`` (:data:`TREND_P1`) of P1; the last, whose heights
     the tile keeps, the whole P1. With the whole P1 the first result was still flattened where the
-    data term is weak against P1 (on seed 2026 scene 9 a hip roof's ridge at 22.0 m read 21.2 m
-    flat over 24 cells, where the truth spans 21.3-22.0 m), and its trend handed that on. With
-    P1 / 4 alone the ridge was found (the data term knows it), but the ground's NMAD rose (scene 9
-    0.24 -> 0.38 GSD); as the first pass only, its slopes reach the final aggregation through the trend, which stays off on
-    flat ground (:data:`TREND_MIN_SLOPE`). Measured with ``bench/osgm_battery.py`` against the whole
-    P1: factor 1/2 on master seeds 2026 and 7, edge3 up on 17 of 24 scenes (up to 2.1 points: seed
-    2026 scene 2 82.6 -> 84.7 %), down on 6 by at most 0.14; seed 2026 scene 9 flat3 96.9 -> 97.1 %.
-    1/4 gained more edge3 (seed 2026 scene 2 +2.9 points) but raised the NMAD on flat ground
-    (seed 7 scene 2 0.456 -> 0.507 GSD, seed 2026 scene 4 0.203 -> 0.235), 1/2 by at most 0.011.
-    On seeds 808, 13 and 99, not used for the choice: edge3 up on 28 of 36 scenes (up to 2.5
-    points: seed 808 scene 10 85.9 -> 88.4 %), down on 7 (seed 99 scene 1 by 0.48, the others by
-    at most 0.05), flat3 up on 28, NMAD within +0.006/-0.018 GSD. The number of aggregations and
-    the time stay the same.
+    data term is weak against P1 (on seed 2026 scene 9 a hip roof's ridge at 22.0 m read 21.2 m flat
+    over 24 cells, where the truth spans 21.3-22.0 m), and its trend handed that on. With P1 / 4
+    alone the ridge was found (the data term knows it), but the ground's NMAD rose (scene 9 0.24 ->
+    0.38 GSD); as the first pass only, its slopes reach the final aggregation through the trend,
+    which stays off on flat ground (:data:`TREND_MIN_SLOPE`). Measured with
+    ``bench/osgm_battery.py`` against the whole P1: factor 1/2 on master seeds 2026 and 7, edge3 up
+    on 17 of 24 scenes (up to 2.1 points: seed 2026 scene 2 82.6 -> 84.7 %), down on 6 by at most
+    0.14; seed 2026 scene 9 flat3 96.9 -> 97.1 %. 1/4 gained more edge3 (seed 2026 scene 2 +2.9
+    points) but raised the NMAD on flat ground (seed 7 scene 2 0.456 -> 0.507 GSD, seed 2026 scene 4
+    0.203 -> 0.235), 1/2 by at most 0.011. On seeds 808, 13 and 99, not used for the choice: edge3
+    up on 28 of 36 scenes (up to 2.5 points: seed 808 scene 10 85.9 -> 88.4 %), down on 7 (seed 99
+    scene 1 by 0.48, the others by at most 0.05), flat3 up on 28, NMAD within +0.006/-0.018 GSD. The
+    number of aggregations and the time stay the same.
     """
     if isinstance(passes, bool) or not isinstance(passes, int | np.integer) or passes < 0:
         raise InputError(f"aggregate_with_trend: passes must be an integer >= 0, got {passes!r}")
