@@ -1148,3 +1148,74 @@ def test_slope_trend_rejects_bad_input():
     with pytest.raises(InputError, match="slope_max"):
         slope_trend(np.zeros((4, 4)), 0.0, 0.25, 1.5)
     assert slope_trend(np.zeros((4, 4)), 0.0, 0.25, 2).shape == (4, 4)
+
+
+def test_fill_unseen_gives_unseen_heights_the_median_of_the_measured():
+    """Inside a cell's band and outside its gap, the COST_MAX levels (fewer than two views) get the
+    median of the levels the cell measured; a cell that measured nothing, a cell that searches
+    nothing and the levels outside the band or in the gap keep what they had."""
+    from truortho.core.osgm.matching import UNSEEN_QUANTILE, fill_unseen
+    from truortho.core.sgm import COST_MAX
+
+    assert UNSEEN_QUANTILE == 0.5
+    nd = 10
+    cost = np.full((1, 4, nd), COST_MAX, np.uint16)
+    cost[0, 0, 2:7] = [500, 100, COST_MAX, 300, 200]  # band 2..8, gap 7..7: measured 500 100 300 200
+    cost[0, 2, 1:4] = [400, COST_MAX, 600]
+    z0 = np.array([[3, 0, 0, 0]], np.int32)  # cell 0's level k is the absolute level 3 + k
+    lo = np.array([[5, 0, 1, 5]], np.int32)
+    hi = np.array([[11, 9, 3, 4]], np.int32)  # cell 3: lo > hi, nothing searched
+    gaps = (np.array([[10, 1, 1, 1]]), np.array([[10, 0, 0, 0]]))
+    before = cost.copy()
+    fill_unseen(cost, lo, hi, z0, gaps)
+    want = before[0, 0].copy()
+    want[[4, 8]] = 200  # the lower median of 100, 200, 300, 500; k = 7 is the gap, k = 0, 1, 9 outside
+    np.testing.assert_array_equal(cost[0, 0], want)
+    np.testing.assert_array_equal(cost[0, 1], before[0, 1])  # measured nothing: no height
+    np.testing.assert_array_equal(cost[0, 2], np.r_[before[0, 2, :2], 400, before[0, 2, 3:]])  # lower median
+    np.testing.assert_array_equal(cost[0, 3], before[0, 3])
+    for bad in (-0.1, 1.5, True, "0.5"):
+        with pytest.raises(InputError, match="quantile must be a number in"):
+            fill_unseen(cost, lo, hi, z0, gaps, quantile=bad)
+    with pytest.raises(InputError, match="uint16"):
+        fill_unseen(cost.astype(np.int32), lo, hi, z0)
+    with pytest.raises(InputError, match="lo, hi and z0 must be"):
+        fill_unseen(cost, lo[:, :2], hi, z0)
+
+
+def test_an_unseen_roof_corner_takes_the_roof_height_not_a_seen_one():
+    """A part of a roof that at the roof's height is in fewer than two frames (COST_MAX from the
+    sweep), while the lower heights there are seen and match nothing: left at COST_MAX, the part
+    takes seen heights; with :func:`fill_unseen` the aggregation carries the roof's height in from
+    the roof around it (over four noise draws). Where such a part touches the ground as much as
+    the roof, nothing tells the two apart, and the fill cannot either."""
+    from truortho.core.osgm.matching import fill_unseen
+    from truortho.core.sgm import COST_MAX, aggregate, select, valid_cells
+
+    rows = cols = 80
+    nd = 60
+    r, c = np.mgrid[0:rows, 0:cols]
+    roof = (r >= 16) & (r < 64) & (c >= 16) & (c < 64)
+    corner = (r >= 36) & (r < 60) & (c >= 28) & (c < 52)  # 4 cells of seen roof to its rim
+    true = np.where(roof, 40, 5)
+    k = np.arange(nd)[None, None, :]
+    z0 = np.zeros((rows, cols), np.int32)
+    lo = np.zeros((rows, cols), np.int32)
+    hi = np.full((rows, cols), nd - 1, np.int32)
+    right = {False: [], True: []}
+    for seed in range(4):
+        rng = np.random.default_rng(seed)
+        cost = 300 + 30 * np.abs(k - true[..., None]) + rng.normal(0, 20, (rows, cols, nd))
+        cost[corner] = 700 + rng.normal(0, 30, (int(corner.sum()), nd))
+        cost = np.clip(cost, 0, COST_MAX - 1).astype(np.uint16)
+        cost[corner, 31:] = COST_MAX  # above 30 levels, fewer than two frames hold the part
+        for fill in right:
+            c2 = cost.copy()
+            if fill:
+                fill_unseen(c2, lo, hi, z0)
+            S = aggregate(c2, 256, 2048, 16, z0)
+            level, _ = select(S, z0, 1.0, valid=valid_cells(c2))
+            right[fill].append(np.abs(np.nan_to_num(level, nan=-99) - true)[corner] <= 1)
+    assert np.mean(right[True]) > 0.95
+    assert np.mean(right[False]) < 0.5
+    assert np.mean(np.abs(np.nan_to_num(level, nan=-99) - true)[~roof] <= 1) > 0.99  # the ground
