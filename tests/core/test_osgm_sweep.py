@@ -148,8 +148,12 @@ def test_sweep_kernels_without_the_jit():
         k.buf, k.off, k.hh, k.ww, k.R, k.C, k.P, k.r2max, k.scale, k.shift, 0.0, 0.0, RES, Z, p.samp, box, p.s
     )
     sw._gradient_phase.py_func(p.s, p.samp, p.win, box, p.inv, p.qx, p.qy, p.vv)
-    sw._pair_terms.py_func(p.qx, p.qy, p.vv, p.win, box, p.pi, p.pj, p.td, p.tm)
-    sw._window_cost.py_func(p.td, p.tm, p.vv, need8, p.win, box, 1, 0.5, 0, p.pi, p.pj, 0, z0, got)
+    sw._row_spans.py_func(p.vv, p.win, box, p.cmin, p.cmax)
+    oi, oj = np.empty(len(p.pi), np.int64), np.empty(len(p.pi), np.int64)
+    m = sw._meeting_pairs.py_func(p.cmin, p.cmax, int(box[0]), int(box[1]), p.pi, p.pj, oi, oj)
+    pi, pj = oi[:m], oj[:m]
+    sw._pair_terms.py_func(p.qx, p.qy, p.vv, p.win, box, pi, pj, p.td, p.tm)
+    sw._window_cost.py_func(p.td, p.tm, p.vv, need8, p.win, box, 1, 0.5, 0, pi, pj, 0, z0, got)
     assert np.array_equal(got, want)
     assert np.all(got[need] < 9999) and np.all(got[~need] == 9999)
 
@@ -200,3 +204,41 @@ def test_smallest_mean_equals_the_quickselect_mean_to_the_bit():
         assert got == want, (trial, nt, kb, m)
         checked += 1
     assert checked > 2500
+
+
+def test_pairs_that_share_no_valid_sample_are_skipped_with_the_same_costs(monkeypatch):
+    """Views whose footprints on the plane do not meet form pairs that can never be valid: the sweep
+    leaves them out (a block's far-apart photos in one coarse tile), here in bands of rows that
+    each keep only the pairs meeting in them, and its costs stay the same to the bit as with every
+    pair."""
+    from truortho.core.osgm import sweep as sw
+
+    rng = np.random.default_rng(7)
+    rows, cols = 200, 40
+    images = _images(rng, 5, rows, cols)
+    for im, (a, b) in zip(images, [(0, 80), (0, 80), (120, 200), (120, 200), (0, 200)], strict=True):
+        cut = np.full(im.window.shape[0], np.nan, np.float32)
+        cut[a + 5 : b + 5] = 0.0  # each photo covers only these rows of the tile (the fifth all)
+        im.window[:] = im.window + cut[:, None]
+    scales = gradient_scales(images, _remap, 0.0, 0.0, RES, rows, cols, Z)
+    need = np.ones((rows, cols), bool)
+    z0 = np.zeros((rows, cols), np.int32)
+    got = np.full((rows, cols, 1), 9999, np.uint16)
+    monkeypatch.setattr(sw, "BAND_GAIN", 1.0)  # bands wherever the plane has more than one
+    p = PlaneSweep(images, rows, cols, 2, 0.5, scales)
+    p.plane(0.0, 0.0, RES, Z, need, 0, z0, got)
+    oi, oj = np.empty(len(p.pi), np.int64), np.empty(len(p.pi), np.int64)
+
+    def meeting(r0, r1):
+        m = sw._meeting_pairs(p.cmin, p.cmax, r0, r1, p.pi, p.pj, oi, oj)
+        return sorted(zip(oi[:m].tolist(), oj[:m].tolist(), strict=True))
+
+    assert meeting(0, rows) == [(0, 1), (0, 4), (1, 4), (2, 3), (2, 4), (3, 4)]
+    assert meeting(0, 60) == [(0, 1), (0, 4), (1, 4)]  # the top band
+    assert meeting(140, rows) == [(2, 3), (2, 4), (3, 4)]
+    every = np.full((rows, cols, 1), 9999, np.uint16)
+    box = np.array([0, rows, 0, cols], np.int64)
+    sw._pair_terms(p.qx, p.qy, p.vv, p.win, box, p.pi, p.pj, p.td, p.tm)
+    sw._window_cost(p.td, p.tm, p.vv, need.astype(np.uint8), p.win, box, 2, 0.5, 0, p.pi, p.pj, 0, z0, every)
+    assert np.array_equal(got, every)
+    assert (got < COST_MAX).mean() > 0.6  # all but rows 80-120, which only the fifth photo sees
