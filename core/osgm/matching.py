@@ -598,13 +598,17 @@ def fill_unseen(cost, lo, hi, z0, gaps=None, quantile: float = UNSEEN_QUANTILE) 
     at ``COST_MAX`` it is the worst a height can score, and the aggregation took the heights that
     more images see instead. Frames cover less area the higher a plane lies, so under a tall roof
     these are the lower heights: on the acceptance battery (master seed 808, scene 4) the corners
-    of a 59 m tower's roof, 1 or 2 frames of 18 wide at its height, were matched 10-30 m low inside
-    the tower, where the volume's heights read the roof's texture in 3 to 8 frames. Such a height
+    of a 59 m tower's roof, in 1 or 2 of the 18 frames at the roof's height, were matched 10-30 m
+    low inside the tower, where 3 to 8 frames see the volume's heights. Such a height
     now costs the ``quantile`` (:data:`UNSEEN_QUANTILE`) of the ``n`` costs the cell measured in
     its band (the value of rank ``int(quantile (n - 1))``: for 0.5 the lower median), and the
     aggregation decides it from the neighbours. Cells that measured nothing keep
     their ``COST_MAX`` column (no height); levels outside ``lo .. hi`` and inside ``gaps``
-    (``(gap_lo, gap_hi)``, not searched) are not touched.
+    (``(gap_lo, gap_hi)``, not searched) are not touched. The sweeps write the same ``COST_MAX``
+    for a measured cost whose best pairs all saturate (the mean rounds to it), and the fill cannot
+    tell the two apart: such a height gets the median too. It is rare (every best pair differing by
+    the whole saturated gradient range), and the pairwise rectified SGM (:mod:`truortho.core.sgm.rectified`),
+    whose out-of-frame disparities are not a matter of height, keeps ``COST_MAX``.
 
     ``cost`` (rows, cols, nd) uint16 C-ordered, level ``k`` of cell (r, c) the absolute level
     ``z0[r, c] + k``; ``lo``, ``hi``, ``z0`` (rows, cols) int.
