@@ -49,8 +49,12 @@ def _images(rng, n, rows, cols):
     return out
 
 
-@pytest.mark.parametrize("n", [2, 3, 6])
-def test_sweep_equals_dense_cost_on_searched_cells(n):
+@pytest.mark.parametrize(("n", "block"), [(2, 64), (3, 64), (6, 64), (6, 7), (3, 16)])
+def test_sweep_equals_dense_cost_on_searched_cells(n, block, monkeypatch):
+    """Also in blocks smaller than the tile (7: many blocks, margins of every kind)."""
+    from truortho.core.osgm import sweep as sw
+
+    monkeypatch.setattr(sw, "BLOCK", block)
     rng = np.random.default_rng(n)
     rows, cols = 57, 71
     images = _images(rng, n, rows, cols)
@@ -145,15 +149,39 @@ def test_sweep_kernels_without_the_jit():
     got = np.full((rows, cols, 1), 9999, np.uint16)
     k = p.pack
     sw._sample_phase.py_func(
-        k.buf, k.off, k.hh, k.ww, k.R, k.C, k.P, k.r2max, k.scale, k.shift, 0.0, 0.0, RES, Z, p.samp, box, p.s
+        k.buf,
+        k.off,
+        k.hh,
+        k.ww,
+        k.R,
+        k.C,
+        k.P,
+        k.r2max,
+        k.scale,
+        k.shift,
+        k.frame,
+        0.0,
+        0.0,
+        RES,
+        Z,
+        p.samp,
+        box,
+        p.s,
     )
     sw._gradient_phase.py_func(p.s, p.samp, p.win, box, p.inv, p.qx, p.qy, p.vv)
-    sw._row_spans.py_func(p.vv, p.win, box, p.cmin, p.cmax)
+    blocks = sw._blocks.py_func(need8, box, 4)
+    assert len(blocks) > 2
     oi, oj = np.empty(len(p.pi), np.int64), np.empty(len(p.pi), np.int64)
-    m = sw._meeting_pairs.py_func(p.cmin, p.cmax, int(box[0]), int(box[1]), p.pi, p.pj, oi, oj)
-    pi, pj = oi[:m], oj[:m]
-    sw._pair_terms.py_func(p.qx, p.qy, p.vv, p.win, box, pi, pj, p.td, p.tm)
-    sw._window_cost.py_func(p.td, p.tm, p.vv, need8, p.win, box, 1, 0.5, 0, pi, pj, 0, z0, got)
+    for blk in blocks:
+        t0, t1 = max(0, blk[0] - 1), min(rows, blk[1] + 1)
+        e0, e1 = max(0, blk[2] - 1), min(cols, blk[3] + 1)
+        m = sw._block_pairs.py_func(p.vv, p.win, t0, t1, e0, e1, p.pi, p.pj, oi, oj)
+        tp = np.empty((t1 - t0, e1 - e0, m), p.unit.dtype)
+        sw._block_terms.py_func(p.qx, p.qy, p.vv, p.win, t0, t1, e0, e1, oi[:m], oj[:m], p.unit[0], tp)
+        work = sw._work_arrays.py_func(e1 - e0, m, len(images), p.unit)
+        sw._block_sums.py_func(
+            tp, p.unit, p.sh, p.vv, need8, p.win, blk, t0, e0, 1, 0.5, 0, oi[:m], oj[:m], 0, z0, got, work
+        )
     assert np.array_equal(got, want)
     assert np.all(got[need] < 9999) and np.all(got[~need] == 9999)
 
@@ -207,10 +235,9 @@ def test_smallest_mean_equals_the_quickselect_mean_to_the_bit():
 
 
 def test_pairs_that_share_no_valid_sample_are_skipped_with_the_same_costs(monkeypatch):
-    """Views whose footprints on the plane do not meet form pairs that can never be valid: the sweep
-    leaves them out (a block's far-apart photos in one coarse tile), here in bands of rows that
-    each keep only the pairs meeting in them, and its costs stay the same to the bit as with every
-    pair."""
+    """Views whose footprints on the plane do not meet form pairs that can never be valid: each block
+    of the sweep keeps only the pairs meeting in it (a block's far-apart photos in one coarse tile),
+    and its costs stay those of every pair (the dense cost) to the bit."""
     from truortho.core.osgm import sweep as sw
 
     rng = np.random.default_rng(7)
@@ -224,21 +251,97 @@ def test_pairs_that_share_no_valid_sample_are_skipped_with_the_same_costs(monkey
     need = np.ones((rows, cols), bool)
     z0 = np.zeros((rows, cols), np.int32)
     got = np.full((rows, cols, 1), 9999, np.uint16)
-    monkeypatch.setattr(sw, "BAND_GAIN", 1.0)  # bands wherever the plane has more than one
+    monkeypatch.setattr(sw, "BLOCK", 30)
     p = PlaneSweep(images, rows, cols, 2, 0.5, scales)
     p.plane(0.0, 0.0, RES, Z, need, 0, z0, got)
     oi, oj = np.empty(len(p.pi), np.int64), np.empty(len(p.pi), np.int64)
 
     def meeting(r0, r1):
-        m = sw._meeting_pairs(p.cmin, p.cmax, r0, r1, p.pi, p.pj, oi, oj)
+        m = sw._block_pairs(p.vv, p.win, r0, r1, 0, cols, p.pi, p.pj, oi, oj)
         return sorted(zip(oi[:m].tolist(), oj[:m].tolist(), strict=True))
 
     assert meeting(0, rows) == [(0, 1), (0, 4), (1, 4), (2, 3), (2, 4), (3, 4)]
-    assert meeting(0, 60) == [(0, 1), (0, 4), (1, 4)]  # the top band
+    assert meeting(0, 60) == [(0, 1), (0, 4), (1, 4)]  # the top blocks
     assert meeting(140, rows) == [(2, 3), (2, 4), (3, 4)]
-    every = np.full((rows, cols, 1), 9999, np.uint16)
-    box = np.array([0, rows, 0, cols], np.int64)
-    sw._pair_terms(p.qx, p.qy, p.vv, p.win, box, p.pi, p.pj, p.td, p.tm)
-    sw._window_cost(p.td, p.tm, p.vv, need.astype(np.uint8), p.win, box, 2, 0.5, 0, p.pi, p.pj, 0, z0, every)
-    assert np.array_equal(got, every)
+    slices = np.stack([_remap(im, 0.0, 0.0, RES, rows, cols, Z) for im in images])
+    every, _ = multi_image_cost(slices, 2, measure="gradient", scales=scales)
+    assert np.array_equal(got[:, :, 0], every)
     assert (got < COST_MAX).mean() > 0.6  # all but rows 80-120, which only the fifth photo sees
+
+
+def test_cells_outside_a_frame_are_not_projected_and_the_samples_are_the_same():
+    """The sampler skips the cells of a row that cannot fall in a photo's window (bounds on the
+    undistorted coordinates widened by the most the distortion can move a point): tilted photos with
+    strong radial and tangential distortion, pyramid windows at an offset, a plane reaching beyond
+    every frame. The samples, valid and NaN, equal those of projecting every cell."""
+    from truortho.core.osgm import sweep as sw
+
+    rng = np.random.default_rng(21)
+    rows, cols, res = 90, 120, 1.5  # 135 m x 180 m; a footprint is about 100 m across
+    out = []
+    for i in range(6):
+        w, h = 160, 120
+        k1 = 0.25 * (-1) ** i
+        cx, cy = w / 2 + rng.normal(0, 4), h / 2 + rng.normal(0, 4)
+        cam = Camera(w, h, 150.0, 152.0, cx, cy, k1, -0.08, 0.03, 0.004, -0.006)
+        tilt, az = np.radians(rng.uniform(0, 40)), rng.uniform(0, 2 * np.pi)
+        down = np.array([np.sin(tilt) * np.cos(az), np.sin(tilt) * np.sin(az), -np.cos(tilt)])
+        x = np.cross(down, [0.0, 0.0, 1.0]) if tilt > 1e-6 else np.array([1.0, 0.0, 0.0])
+        x /= np.linalg.norm(x)
+        R = np.stack([x, np.cross(down, x), down])
+        C = np.array([rng.uniform(0, cols * res), -rng.uniform(0, rows * res), H]) - 40.0 * np.array(
+            [down[0], down[1], 0.0]
+        )
+        img = rng.uniform(0, 255, (h // 2 - 7, w // 2 - 9)).astype(np.float32)
+        out.append(TileImage(View(i, R, C, cam, 0.5, 1.0), 1, (5, 4), img, 0.0))
+    pack = sw.PackedImages(out)
+    assert np.all(np.isfinite(pack.frame))
+    samp = np.ones((rows, cols), np.uint8)
+    box = np.array([0, rows, 0, cols], np.int64)
+    got = np.empty((rows, cols, len(out)), np.float32)
+    want = np.empty_like(got)
+    unbounded = np.tile([-np.inf, np.inf, -np.inf, np.inf], (len(out), 1))
+    for z in (-30.0, Z, 60.0):
+        args = (
+            pack.buf,
+            pack.off,
+            pack.hh,
+            pack.ww,
+            pack.R,
+            pack.C,
+            pack.P,
+            pack.r2max,
+            pack.scale,
+            pack.shift,
+        )
+        sw._sample_phase(*args, pack.frame, 0.0, 0.0, res, z, samp, box, got)
+        sw._sample_phase(*args, unbounded, 0.0, 0.0, res, z, samp, box, want)
+        assert np.array_equal(got, want, equal_nan=True)
+        valid = np.isfinite(want).mean(axis=(0, 1))
+        assert np.all(valid > 0.01) and np.all(valid < 0.8), valid  # every photo sees part of the plane
+
+
+def test_frame_columns_stay_inside_the_row():
+    """The column range of a row that may project into a frame is always inside ``[c0, c1]`` (the
+    sampler writes NaN on either side of it): frames left of, right of, across and off the row, rays
+    parallel to the plane, and non-finite bounds."""
+    from truortho.core.osgm.sweep import _frame_columns
+
+    rng = np.random.default_rng(9)
+    c0, c1 = 7, 50
+    for trial in range(20000):
+        bx, by, bz = rng.normal(0, 50, 3)
+        sx, sy, sz = rng.normal(0, 1, 3) * rng.choice([0.0, 1e-9, 1.0, 5.0], 3)
+        fb = np.sort(rng.normal(0, 1, 2)).tolist() + np.sort(rng.normal(0, 1, 2)).tolist()
+        if trial % 7 == 0:
+            fb[rng.integers(0, 4)] = rng.choice([np.inf, -np.inf, np.nan])
+        ca, cb = _frame_columns(bx, by, bz, sx, sy, sz, np.array(fb), c0, c1)
+        assert c0 <= ca <= cb <= c1, (trial, ca, cb)
+        # the range holds every column whose centre projects inside the bounds
+        t = np.arange(c0, c1) + 0.5
+        zc = bz + t * sz
+        with np.errstate(all="ignore"):
+            x, y = (bx + t * sx) / zc, (by + t * sy) / zc
+            inside = (zc > 0) & (x >= fb[0]) & (x <= fb[1]) & (y >= fb[2]) & (y <= fb[3])
+        cols = np.arange(c0, c1)[inside]
+        assert np.all((cols >= ca) & (cols < cb)), (trial, ca, cb, cols)
