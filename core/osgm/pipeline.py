@@ -467,7 +467,7 @@ def _match_system(
                 cache=cache,
                 key=(lambda t: t.key(base)) if cache is not None else None,
                 label=f"{system.name}: level {lv}",
-                memory=task_memory(side, side, MAX_BAND, params.max_images, 4 * side * side),
+                memory=task_memory(side, side, MAX_BAND, params.max_images, 4 * side * side, params.radius),
             )
         except CancelledError:
             raise CancelledError("OSGM cancelled") from None

@@ -235,14 +235,20 @@ def osgm_tile_task(ctx: TileContext, task: TileTask) -> tuple[np.ndarray, np.nda
     return np.ascontiguousarray(res.z[ins]), np.ascontiguousarray(res.confidence[ins])
 
 
-def task_memory(rows: int, cols: int, nd: int, n_images: int, window_pixels: int) -> int:
+def task_memory(rows: int, cols: int, nd: int, n_images: int, window_pixels: int, radius: int = 2) -> int:
     """Bytes one task needs at most (module docstring): volumes, windows, per-cell arrays."""
+    from ..jit import numba
+    from .sweep import BLOCK, _packing
+
     cells = int(rows) * int(cols)
     volumes = cells * int(nd) * 2 * 2  # cost + aggregated, uint16
     windows = int(n_images) * int(window_pixels) * 4  # float32 image windows
     per_cell = cells * 4 * 16  # lo, hi, z0, guide, remapped slices, level, confidence, ...
     n = int(n_images)
-    # the plane sweep's work arrays (.sweep): samples, gradients and validity per image, terms per pair
-    sweep = cells * (n * (4 + 2 + 2 + 1) + (n * (n - 1) // 2) * 3)
+    # the plane sweep's work arrays (.sweep): samples, gradients and validity per image, and every
+    # thread's packed pair terms of one block with its margins
+    side = BLOCK + 2 * int(radius)
+    terms = side * side * (n * (n - 1) // 2) * _packing(int(radius))[0].itemsize
+    sweep = cells * n * (4 + 2 + 2 + 1) + int(numba.config.NUMBA_NUM_THREADS) * terms
     # and its windows packed once more into one buffer
     return volumes + 2 * windows + per_cell + sweep
