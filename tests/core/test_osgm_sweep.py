@@ -175,7 +175,9 @@ def test_sweep_kernels_without_the_jit():
     for blk in blocks:
         t0, t1 = max(0, blk[0] - 1), min(rows, blk[1] + 1)
         e0, e1 = max(0, blk[2] - 1), min(cols, blk[3] + 1)
-        m = sw._block_pairs.py_func(p.vv, p.win, t0, t1, e0, e1, p.pi, p.pj, oi, oj)
+        m = sw._block_pairs.py_func(
+            p.vv, p.win, t0, t1, e0, e1, p.pi, p.pj, oi, oj, np.empty((4, 3), np.int64)
+        )
         tp = np.empty((t1 - t0, e1 - e0, m), p.unit.dtype)
         sw._block_terms.py_func(p.qx, p.qy, p.vv, p.win, t0, t1, e0, e1, oi[:m], oj[:m], p.unit[0], tp)
         work = sw._work_arrays.py_func(e1 - e0, m, len(images), p.unit)
@@ -257,7 +259,7 @@ def test_pairs_that_share_no_valid_sample_are_skipped_with_the_same_costs(monkey
     oi, oj = np.empty(len(p.pi), np.int64), np.empty(len(p.pi), np.int64)
 
     def meeting(r0, r1):
-        m = sw._block_pairs(p.vv, p.win, r0, r1, 0, cols, p.pi, p.pj, oi, oj)
+        m = sw._block_pairs(p.vv, p.win, r0, r1, 0, cols, p.pi, p.pj, oi, oj, np.empty((4, 5), np.int64))
         return sorted(zip(oi[:m].tolist(), oj[:m].tolist(), strict=True))
 
     assert meeting(0, rows) == [(0, 1), (0, 4), (1, 4), (2, 3), (2, 4), (3, 4)]
