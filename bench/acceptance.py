@@ -36,7 +36,9 @@ Per scene, against the exact truth on the truth DSM's grid (the scene extent at 
 * the true ortho's colour edges (``TrueOrthoConfig.edge_colour``, default ``checked``; not a goal):
   the ghosting on the truth and the OSGM DSM also with them off and in the mode for exact surfaces
   (``ortho_truth_edge_off``, ``ortho_truth_edge_surface``, ``ortho_osgm_edge_off``,
-  ``ortho_osgm_edge_surface``);
+  ``ortho_osgm_edge_surface``); and without the agreement of the views (``ortho_truth_agree_off``,
+  ``ortho_osgm_agree_off``: ``TrueOrthoConfig.consistency = 0``), with the scenes each figure is
+  lower and higher on, and the time ratio;
 * a calibration of the ghosting goal (not a goal): the truth DSM with every outline one cell off
   (``truth_shift1``, moved one cell east), its DSM figures, and the ghosting of the true ortho on
   it (``ortho_shift1``).
@@ -438,6 +440,9 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
         ("ortho_truth_edge_surface", "dsm.tif", True, {"edge_colour": "surface"}),
         ("ortho_osgm_edge_off", "osgm.tif", True, {"edge_colour": "off"}),
         ("ortho_osgm_edge_surface", "osgm.tif", True, {"edge_colour": "surface"}),
+        # without the agreement of the views (TrueOrthoConfig.consistency, default 0.1)
+        ("ortho_truth_agree_off", "dsm.tif", True, {"consistency": 0.0}),
+        ("ortho_osgm_agree_off", "osgm.tif", True, {"consistency": 0.0}),
     )
     for key, surface, vis, changes in runs:
         path = os.path.join(folder, f"{key}.tif")
@@ -577,6 +582,11 @@ def summary(rows: list[dict]) -> list[str]:
         "ortho_osgm_edge_off.ghosting",
         "ortho_osgm_edge_surface.ghosting",
         "ortho_osgm_edge_off.ghosting_beyond_outline",
+        "ortho_truth_agree_off.ghosting",
+        "ortho_truth_agree_off.relative_dE",
+        "ortho_osgm_agree_off.ghosting",
+        "ortho_osgm_agree_off.ghosting_beyond_outline",
+        "ortho_osgm_agree_off.relative_dE",
         "truth_shift1.edge3",
         "truth_shift1.flat3",
         "ortho_shift1.ghosting",
@@ -588,6 +598,34 @@ def summary(rows: list[dict]) -> list[str]:
         low_is_bad = any(k in name for k in ("completeness", "flat3", "edge3"))  # flat3_seen3 too
         worst = np.nanmin(vals) if low_is_bad else np.nanmax(vals)
         lines.append(f"| {name} (not a goal) | | {np.nanmedian(vals):.4g} | {worst:.4g} | |")
+    # the agreement of the views, scene by scene: with it (the default) against without
+    for key, name in (
+        ("ortho_truth", "ghosting"),
+        ("ortho_truth", "relative_dE"),
+        ("ortho_osgm", "ghosting"),
+        ("ortho_osgm", "ghosting_beyond_outline"),
+        ("ortho_osgm", "relative_dE"),
+    ):
+        if all(f"{key}_agree_off" in r for r in rows):
+            on = np.array([r[key][name] for r in rows])
+            off = np.array([r[f"{key}_agree_off"][name] for r in rows])
+            lines.append(
+                f"| {key}.{name}: scenes lower / higher than without the agreement of the views "
+                f"(not a goal) | | {int((on < off).sum())} / {int((on > off).sum())} | "
+                f"{np.max(on - off):+.4g} | |"
+            )
+    if all("ortho_osgm_agree_off" in r for r in rows):
+        t = np.array(
+            [
+                (r["ortho_truth"]["seconds"] + r["ortho_osgm"]["seconds"])
+                / (r["ortho_truth_agree_off"]["seconds"] + r["ortho_osgm_agree_off"]["seconds"])
+                for r in rows
+            ]
+        )
+        lines.append(
+            f"| true ortho time with / without the agreement of the views | | {np.median(t):.3g} | "
+            f"{t.max():.3g} | |"
+        )
     spm = np.array([r["osgm"]["s_per_mcell_image"] for r in rows])
     lines.append(f"| OSGM s per million (cells x images) | | {np.median(spm):.3g} | {spm.max():.3g} | |")
     allok = sum(not r["failed"] for r in rows)

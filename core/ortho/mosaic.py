@@ -28,7 +28,7 @@ from ..jit import njit
 from .color import ColorCorrection, value_scale
 from .edgecolour import EDGE_COLOURS, surface_edge_colour
 from .seams import feather_weights
-from .select import data_costs, select_labels
+from .select import add_disagreement, data_costs, select_labels
 from .views import TileViews
 
 
@@ -199,6 +199,9 @@ class MosaicParams:
     blend_width: int = 5
     sweeps: int = 8
     edge_colour: str = "off"  # :data:`~.edgecolour.EDGE_COLOURS`
+    #: Largest colour difference from the consensus of a cell's views (fraction of the value
+    #: scale) of a view that agrees with it (:func:`~.select.add_disagreement`); 0 = off.
+    consistency: float = 0.0
 
     def __post_init__(self) -> None:
         # TrueOrthoConfig checks its own copy; code that builds the parameters directly must not get
@@ -206,6 +209,8 @@ class MosaicParams:
         if self.edge_colour not in EDGE_COLOURS:
             want = ", ".join(EDGE_COLOURS)
             raise InputError(f"MosaicParams.edge_colour: expected one of {want}, got {self.edge_colour!r}")
+        if not (0.0 <= self.consistency < math.inf):
+            raise InputError(f"MosaicParams.consistency: expected a number >= 0, got {self.consistency!r}")
 
 
 @dataclass
@@ -411,6 +416,13 @@ def mosaic_tile(
     seen = usable.any(axis=0)
     occl[valid & seen] = 0
     cost = data_costs(views.eff_res, usable, views.near_edge, params.edge_penalty)
+    colours = None
+    clean = usable & ~views.near_edge
+    if params.consistency > 0 and K >= 3:
+        # every usable candidate's colour, for the agreement of the views; the blend reads the same
+        # samples and leaves out the views that disagree
+        colours = candidate_colours(views, store, correction, res, None, workers)
+        clean &= ~add_disagreement(cost, colours, usable, params.consistency * value_scale(store.dtype))
     # the seam cost uses every candidate's luminance corrected by the lightness (or first band)
     # gain and offset; colours (fully corrected) are sampled below only where they enter the mosaic
     lum = candidate_luminance(views, store, res, workers)
@@ -442,10 +454,10 @@ def mosaic_tile(
         sweeps=params.sweeps,
         fixed=local_fixed,
     )
-    clean = usable & ~views.near_edge
     w = feather_weights(labels, clean, params.blend_width)
     # _blend reads a candidate's colour only where its weight is positive: only those are sampled
-    colours = candidate_colours(views, store, correction, res, w > 0, workers, fill=False)
+    if colours is None:
+        colours = candidate_colours(views, store, correction, res, w > 0, workers, fill=False)
     values = np.empty((bands, rows, cols), np.float32)
     _blend(w, colours, values)
     alpha = labels >= 0

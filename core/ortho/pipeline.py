@@ -146,6 +146,13 @@ class TrueOrthoConfig:
         than the other side's, so that a DSM whose outlines are a cell or two off does not get
         roof colours painted on the ground. ``surface``: every such cell, for surfaces whose
         outlines are exact (LiDAR DSM, building model). RGB only.
+    consistency : float
+        A view whose colour differs from the consensus of a cell's views (the per-band median of
+        at least three) by more than this fraction of the value scale (255 for 8-bit) on some band,
+        where at least two views agree within it, is taken only when no agreeing view has pixels
+        less than three times as large on the surface (:func:`~.select.add_disagreement`): where
+        the surface is wrong (a matched DSM's raised ground beside a wall, a roof corner matched too
+        low) or one photo holds a car that moved, the views that agree give the colour. 0 = off.
     color_cells : int
         Cells of the decimated grid used to estimate the colour correction.
     workers : int
@@ -207,6 +214,7 @@ class TrueOrthoConfig:
     image_cache_mb: int = 1024
     restore_chroma: bool = True
     edge_colour: str = "checked"
+    consistency: float = 0.1
     color_cells: int = 60_000
     workers: int = 2
     cog: bool = True
@@ -257,6 +265,8 @@ class TrueOrthoConfig:
 
         if self.edge_colour not in EDGE_COLOURS:
             bad("edge_colour", f"expected one of {', '.join(EDGE_COLOURS)}")
+        if not isinstance(self.consistency, int | float) or not 0.0 <= self.consistency <= 1.0:
+            bad("consistency", "expected a number from 0 (off) to 1")
         if self.compression not in ORTHO_COMPRESSIONS:
             bad("compression", f"expected one of {', '.join(ORTHO_COMPRESSIONS)}")
         if self.compression == "jpeg" and not self.cog:
@@ -742,6 +752,7 @@ def run_mosaic(
         cfg.blend_width,
         cfg.sweeps,
         cfg.edge_colour,
+        float(cfg.consistency),
     )
     workers = max(1, int(cfg.workers))
     stats: dict = {}
@@ -971,7 +982,7 @@ def open_products(
 #: Part of every cached tile's key: raise it when a change of the visibility, selection or mosaic
 #: changes the tiles for the same inputs and parameters (2: near-field visibility, noise tolerance),
 #: so that a cache kept from an interrupted run of an older version is not reused.
-CACHE_VERSION = 2
+CACHE_VERSION = 3
 
 
 def _cache_base(o, paths, relevant, surf, cfg, correction, grid, out_crs) -> str:

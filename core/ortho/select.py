@@ -21,6 +21,17 @@ not, and where the two images disagree in luminance ``I`` (misregistration,
 strong edges seen differently) a seam is more expensive
 (Kwatra et al.'s graph-cut-textures seam cost).
 
+Agreement of the views
+----------------------
+Where the surface is wrong (a matched DSM's raised ground beside a wall, a roof corner matched
+too low) or a photo holds what the others do not (a car that moved, a person), the image that wins
+the data term can show something other than the cell, although the other images that see the cell
+agree on its colour. With at least three candidates, the per-band median of their (corrected)
+colours is the cell's consensus; a candidate farther than ``tau`` from it on some band, in a cell
+where at least two candidates lie within ``tau``, costs :data:`DISAGREE_PENALTY` more
+(:func:`add_disagreement`). One or two candidates say nothing about which is right and are left
+alone, as are cells whose candidates scatter.
+
 Optimisation
 ------------
 The energy is minimised approximately (:func:`select_labels`):
@@ -45,6 +56,7 @@ import math
 
 import numpy as np
 
+from ..errors import InputError
 from ..jit import njit
 
 NO_LABEL = -1
@@ -83,6 +95,68 @@ def _data_costs(eff, vis, edge, penalty, out):
                     out[k, r, c] = v
                 else:
                     out[k, r, c] = np.inf
+
+
+#: Data cost added to a candidate whose colour disagrees with the consensus of a cell's views
+#: (module docstring): an agreeing view wins unless its pixels on the surface are more than three
+#: times as large.
+DISAGREE_PENALTY = 2.0
+
+
+def add_disagreement(cost: np.ndarray, colours: np.ndarray, usable: np.ndarray, tau: float) -> np.ndarray:
+    """Add :data:`DISAGREE_PENALTY` to ``cost`` (K, rows, cols) float32, in place, for the usable
+    candidates whose colour (``colours`` (K, rows, cols, bands), NaN where not sampled) lies more
+    than ``tau`` (value units) from the per-band median of the cell's usable candidates on some
+    band, in the cells with at least three usable candidates of which at least two lie within
+    ``tau`` (module docstring). Returns the (K, rows, cols) bool mask of the penalised entries (the
+    blend leaves them out too)."""
+    K, rows, cols = usable.shape
+    if colours.shape[:3] != (K, rows, cols) or cost.shape != (K, rows, cols):
+        shapes = f"{cost.shape}, {colours.shape}, {usable.shape}"
+        raise InputError(f"add_disagreement: shapes {shapes} of cost, colours and usable do not match")
+    if not (tau > 0.0 and math.isfinite(tau)):
+        raise InputError(f"add_disagreement: tau must be a positive number, got {tau!r}")
+    far = np.zeros((K, rows, cols), np.bool_)
+    if K >= 3:
+        _add_disagreement(cost, colours, usable, float(tau), DISAGREE_PENALTY, far)
+    return far
+
+
+@njit
+def _add_disagreement(cost, colours, usable, tau, penalty, out):
+    K, rows, cols, B = colours.shape
+    idx = np.empty(K, np.int64)
+    vals = np.empty(K)
+    med = np.empty(B)
+    far = np.empty(K, np.bool_)
+    for r in range(rows):
+        for c in range(cols):
+            n = 0
+            for k in range(K):
+                if usable[k, r, c] and colours[k, r, c, 0] == colours[k, r, c, 0]:
+                    idx[n] = k
+                    n += 1
+            if n < 3:
+                continue
+            for b in range(B):
+                for j in range(n):
+                    vals[j] = colours[idx[j], r, c, b]
+                v = np.sort(vals[:n])
+                med[b] = 0.5 * (v[(n - 1) // 2] + v[n // 2])
+            agree = 0
+            for j in range(n):
+                far[j] = False
+                for b in range(B):
+                    if abs(colours[idx[j], r, c, b] - med[b]) > tau:
+                        far[j] = True
+                        break
+                if not far[j]:
+                    agree += 1
+            if agree >= 2:
+                for j in range(n):
+                    if far[j]:
+                        cost[idx[j], r, c] += penalty
+                        out[idx[j], r, c] = True
 
 
 def edge_weights(h: np.ndarray, h0: float):

@@ -269,6 +269,9 @@ def test_bad_input_gives_clear_errors_and_no_output(data, tmp_path):
         )
     with pytest.raises(CRSError, match="no transformation"):
         true_ortho(f / "orientation.json", f / "dsm.tif", out, config=TrueOrthoConfig(crs="IAU_2015:49910"))
+    for bad in (-0.1, 1.5, float("nan"), "0.1"):
+        with pytest.raises(InputError, match="consistency"):
+            true_ortho(f / "orientation.json", f / "dsm.tif", out, config=TrueOrthoConfig(consistency=bad))
     # images missing on disk
     o = Orientation.load(f / "orientation.json")
     o2 = dataclasses.replace(o, image_root=str(tmp_path / "nowhere"))
@@ -474,3 +477,58 @@ def test_vignetting_is_removed_from_the_mosaic(tmp_path):
             cams = r.stats["color_correction"]["vignetting"]["cameras"]
             assert all(c["used"] for c in cams.values()), cams
     assert dE[True] < 0.8 * dE[False], dE
+
+
+def test_a_thing_only_one_photo_holds_is_left_out_where_the_others_agree(data, tmp_path):
+    """A magenta blob (a car that moved, a person) painted into the photo that textures a patch of
+    open ground: with the agreement of the views (``consistency``, the default) the patch shows the
+    ground the other photos see; without it, the blob."""
+    import cv2
+
+    scene, grid = data["scene"], data["grid"]
+    folder = tmp_path / "blob"
+    scene.write(folder)
+    cfg = dict(color_correction=False, tile_size=256)
+
+    def run(name, **kw):
+        out, idx = folder / f"{name}.tif", folder / f"{name}_idx.tif"
+        ocfg = TrueOrthoConfig(**cfg, **kw)
+        return true_ortho(folder / "orientation.json", folder / "dsm.tif", out, idx, None, ocfg)
+
+    first = run("before")
+    idx, _, _ = read_raster(first.source_index)
+    counts = ev.truth_view_counts(scene, grid, 45.0, tol=0.05)
+    # open ground that at least four photos see, far from buildings, textured by one photo
+    from scipy.ndimage import binary_erosion, distance_transform_edt
+
+    far = distance_transform_edt(~data["buildings"]) > 8
+    ok = binary_erosion(far & (counts >= 4), iterations=6)
+    labels, n = np.unique(idx[ok], return_counts=True)
+    photo = int(labels[np.argmax(n)])
+    rr, cc = np.nonzero(ok & (idx == photo))
+    pick = np.argsort(np.hypot(rr - rr.mean(), cc - cc.mean()))[0]
+    r0, c0 = rr[pick], cc[pick]
+    yy, xx = np.mgrid[: grid.rows, : grid.cols]
+    patch = (np.hypot(yy - r0, xx - c0) <= 5) & ok & (idx == photo)
+    assert patch.sum() >= 40
+    P = ev.grid_points(scene, grid).reshape(grid.rows, grid.cols, 3)[patch]
+    vis, uv, _ = scene.visibility(P, photo, tol=0.05)
+    assert vis.all()
+    im = scene.orientation.images[photo]
+    path = folder / (im.path or im.name)
+    img = cv2.imread(str(path))
+    for u, v in uv:
+        cv2.circle(img, (int(round(u)), int(round(v))), 2, (255, 0, 255), -1)  # BGR magenta
+    assert cv2.imwrite(str(path), img)
+
+    def patch_de(r):
+        a, _, _ = read_raster(r.output, band=None)
+        rgb = np.moveaxis(a[:3], 0, -1)
+        assert (a[3][patch] > 0).all()
+        return ev.delta_e(rgb, data["truth"])[patch]
+
+    off = patch_de(run("off", consistency=0.0))
+    on = patch_de(run("on"))
+    print("patch dE without / with the agreement of the views:", np.median(off), np.median(on))
+    assert np.median(off) > 40  # the blob shows
+    assert np.median(on) < 8 and (on < 20).mean() > 0.9

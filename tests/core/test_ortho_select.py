@@ -3,9 +3,17 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
+from truortho.core.errors import InputError
 from truortho.core.ortho.seams import feather_weights
-from truortho.core.ortho.select import edge_weights, initial_labels, select_labels
+from truortho.core.ortho.select import (
+    DISAGREE_PENALTY,
+    add_disagreement,
+    edge_weights,
+    initial_labels,
+    select_labels,
+)
 
 
 def _energy(labels, cost, lum, h, h0, smooth, contrast):
@@ -111,3 +119,58 @@ def test_segments_are_the_step_connected_components():
                                 todo.append((rr, cc))
                 n += 1
         np.testing.assert_array_equal(got, ref)
+
+
+def _disagreement_reference(colours, usable, tau):
+    """Obvious-but-slow penalty of every (candidate, cell): module docstring, *Agreement of the views*."""
+    K, R, C, B = colours.shape
+    out = np.zeros((K, R, C))
+    for r in range(R):
+        for c in range(C):
+            ks = [k for k in range(K) if usable[k, r, c] and np.isfinite(colours[k, r, c, 0])]
+            if len(ks) < 3:
+                continue
+            med = np.median(colours[ks, r, c].astype(np.float64), axis=0)
+            far = [k for k in ks if np.any(np.abs(colours[k, r, c] - med) > tau)]
+            if len(ks) - len(far) >= 2:
+                out[far, r, c] = DISAGREE_PENALTY
+    return out
+
+
+def test_disagreeing_views_pay_where_others_agree():
+    rng = np.random.default_rng(11)
+    K, R, C, B = 6, 40, 50, 3
+    truth = rng.uniform(0, 255, (R, C, B))
+    colours = (truth[None] + rng.normal(0, 4, (K, R, C, B))).astype(np.float32)
+    # a few views see something else (an outlier), some cells have views scattered everywhere
+    odd = rng.random((K, R, C)) < 0.2
+    colours[odd] = rng.uniform(0, 255, (int(odd.sum()), B))
+    scatter = rng.random((R, C)) < 0.1
+    colours[:, scatter] = rng.uniform(0, 255, (K, int(scatter.sum()), B))
+    usable = rng.random((K, R, C)) < 0.8
+    colours[~usable & (rng.random((K, R, C)) < 0.5)] = np.nan  # not sampled where not usable
+    cost = rng.uniform(0, 1, (K, R, C)).astype(np.float32)
+    before = cost.copy()
+    far = add_disagreement(cost, colours, usable, 25.0)
+    ref = _disagreement_reference(colours, usable, 25.0)
+    np.testing.assert_allclose(cost - before, ref, atol=1e-6)
+    assert np.array_equal(far, ref > 0)
+    # the rule does what it is for: the odd views pay, the views that agree do not
+    paid = (cost - before) > 0
+    majority = ((usable & ~odd).sum(0) > (usable & odd).sum(0)) & ((usable & ~odd).sum(0) >= 2) & ~scatter
+    assert paid[odd & usable & majority[None]].mean() > 0.95
+    assert paid[~odd & usable & ~scatter[None]].mean() < 0.01
+    # one or two views say nothing; the unusable never pay
+    assert not paid[:, usable.sum(0) < 3].any() and not paid[~usable].any()
+
+
+def test_disagreement_checks_its_input():
+    cost = np.zeros((3, 2, 2), np.float32)
+    colours = np.zeros((3, 2, 2, 3), np.float32)
+    usable = np.ones((3, 2, 2), bool)
+    with pytest.raises(InputError, match="tau"):
+        add_disagreement(cost, colours, usable, 0.0)
+    with pytest.raises(InputError, match="shapes"):
+        add_disagreement(cost, colours[:2], usable, 10.0)
+    # two candidates: nothing to compare
+    assert not add_disagreement(cost[:2], colours[:2], usable[:2], 10.0).any()
