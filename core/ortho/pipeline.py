@@ -95,7 +95,9 @@ class TrueOrthoConfig:
     blend_width : int
         Feathering width across seams, cells (0 = none).
     visibility : bool
-        False gives the conventional orthorectification (no depth test), for comparisons.
+        False gives the conventional orthorectification (no depth test), for comparisons: without
+        the agreement of the views either (``consistency`` is not applied), which would otherwise
+        drop most of the occluded views' colours that such an ortho is compared for.
     tile_size : int
         Core tile side in cells (memory grows with its square times the images per tile).
     depth_tolerance : float
@@ -152,7 +154,8 @@ class TrueOrthoConfig:
         where at least two views agree within it, is taken only when no agreeing view has pixels
         less than three times as large on the surface (:func:`~.select.add_disagreement`): where
         the surface is wrong (a matched DSM's raised ground beside a wall, a roof corner matched too
-        low) or one photo holds a car that moved, the views that agree give the colour. 0 = off.
+        low) or one photo holds a car that moved, the views that agree give the colour. 0 = off;
+        not applied with ``visibility=False``.
     color_cells : int
         Cells of the decimated grid used to estimate the colour correction.
     workers : int
@@ -752,7 +755,7 @@ def run_mosaic(
         cfg.blend_width,
         cfg.sweeps,
         cfg.edge_colour,
-        float(cfg.consistency),
+        float(cfg.consistency) if cfg.visibility else 0.0,
     )
     workers = max(1, int(cfg.workers))
     stats: dict = {}

@@ -204,6 +204,22 @@ def test_tiles_shrink_to_the_memory_budget_and_keep_the_quality(data, monkeypatc
     assert tiny.stats["tile_size"] >= op.MIN_TILE_SIZE
 
 
+def test_the_conventional_ortho_is_made_without_the_agreement_of_the_views(data):
+    """``visibility=False`` is the reference a true ortho is compared with: the agreement of the views
+    (which drops most occluded views' colours) is not applied to it."""
+    plain = _run(data, "conv_plain", visibility=False, consistency=0.0)
+    default = _run(data, "conv_default", visibility=False)
+    a, _, _ = read_raster(plain.output, band=None)
+    b, _, _ = read_raster(default.output, band=None)
+    assert np.array_equal(a, b)
+    # while the true ortho does change with it
+    t0 = _run(data, "true_plain", consistency=0.0)
+    t1 = _run(data, "true_default")
+    c, _, _ = read_raster(t0.output, band=None)
+    d, _, _ = read_raster(t1.output, band=None)
+    assert not np.array_equal(c, d)
+
+
 def test_views_per_cell_keeps_what_is_seen_and_the_quality(data):
     """Lazy candidates (VIEWS_PER_CELL): fewer (cell, image) samples, the same cells seen and
     occluded (a cell short of views tries every image), ghosting and dE as with every image."""
