@@ -424,7 +424,8 @@ def mosaic_tile(
         colours = candidate_colours(views, store, correction, res, None, workers)
         clean &= ~add_disagreement(cost, colours, usable, params.consistency * value_scale(store.dtype))
     # the seam cost uses every candidate's luminance corrected by the lightness (or first band)
-    # gain and offset; colours (fully corrected) are sampled below only where they enter the mosaic
+    # gain and offset; without the agreement of the views, colours (fully corrected) are sampled
+    # below only where they enter the mosaic
     lum = candidate_luminance(views, store, res, workers)
     if correction is not None:
         for k, i in enumerate(views.cands):

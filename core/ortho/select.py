@@ -139,10 +139,15 @@ def _add_disagreement(cost, colours, usable, tau, penalty, out):
             if n < 3:
                 continue
             for b in range(B):
+                # insertion sort of the n values (a handful of views; no allocation per cell)
                 for j in range(n):
-                    vals[j] = colours[idx[j], r, c, b]
-                v = np.sort(vals[:n])
-                med[b] = 0.5 * (v[(n - 1) // 2] + v[n // 2])
+                    x = colours[idx[j], r, c, b]
+                    i = j
+                    while i > 0 and vals[i - 1] > x:
+                        vals[i] = vals[i - 1]
+                        i -= 1
+                    vals[i] = x
+                med[b] = 0.5 * (vals[(n - 1) // 2] + vals[n // 2])
             agree = 0
             for j in range(n):
                 far[j] = False
