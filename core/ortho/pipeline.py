@@ -150,12 +150,13 @@ class TrueOrthoConfig:
         outlines are exact (LiDAR DSM, building model). RGB only.
     consistency : float
         A view whose colour differs from the consensus of a cell's views (the per-band median of
-        at least three) by more than this fraction of the value scale (255 for 8-bit) on some band,
-        where at least two views agree within it, is taken only when no agreeing view has pixels
-        less than three times as large on the surface (:func:`~.select.add_disagreement`): where
-        the surface is wrong (a matched DSM's raised ground beside a wall, a roof corner matched too
-        low) or one photo holds a car that moved, the views that agree give the colour. 0 = off;
-        not applied with ``visibility=False``.
+        at least three) by more than this fraction of the value scale (255 for 8-bit, 65535 for
+        16-bit, 1 for float data, which should then lie in [0, 1]) on some band, where at least
+        two views agree within it, is taken only when no agreeing view has pixels less than three
+        times as large on the surface (:func:`~.select.add_disagreement`): where the surface is
+        wrong (a matched DSM's raised ground beside a wall, a roof corner matched too low) or one
+        photo holds a car that moved, the views that agree give the colour. 0 = off; not applied
+        with ``visibility=False``.
     color_cells : int
         Cells of the decimated grid used to estimate the colour correction.
     workers : int
