@@ -58,6 +58,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..jit import njit
+from ..quickselect import select_rank
 
 NO_LABEL = -1
 
@@ -110,6 +111,11 @@ def add_disagreement(cost: np.ndarray, colours: np.ndarray, usable: np.ndarray, 
     band, in the cells with at least three usable candidates of which at least two lie within
     ``tau`` (module docstring). Returns the (K, rows, cols) bool mask of the penalised entries (the
     blend leaves them out too)."""
+    if usable.ndim != 3 or colours.ndim != 4:
+        raise InputError(
+            f"add_disagreement: expected usable (K, rows, cols) and colours (K, rows, cols, bands), "
+            f"got {usable.shape} and {colours.shape}"
+        )
     K, rows, cols = usable.shape
     if colours.shape[:3] != (K, rows, cols) or cost.shape != (K, rows, cols):
         shapes = f"{cost.shape}, {colours.shape}, {usable.shape}"
@@ -139,15 +145,16 @@ def _add_disagreement(cost, colours, usable, tau, penalty, out):
             if n < 3:
                 continue
             for b in range(B):
-                # insertion sort of the n values (a handful of views; no allocation per cell)
                 for j in range(n):
-                    x = colours[idx[j], r, c, b]
-                    i = j
-                    while i > 0 and vals[i - 1] > x:
-                        vals[i] = vals[i - 1]
-                        i -= 1
-                    vals[i] = x
-                med[b] = 0.5 * (vals[(n - 1) // 2] + vals[n // 2])
+                    vals[j] = colours[idx[j], r, c, b]
+                h = n // 2
+                select_rank(vals, 0, n - 1, h)
+                low = vals[h]
+                if n % 2 == 0:  # the other middle value: the largest of the lower half
+                    low = vals[0]
+                    for j in range(1, h):
+                        low = max(low, vals[j])
+                med[b] = 0.5 * (low + vals[h])
             agree = 0
             for j in range(n):
                 far[j] = False
