@@ -7,7 +7,10 @@ pair costs of a voxel with it, and the colour statistics of the true ortho
 
 from __future__ import annotations
 
-from .jit import njit
+import numpy as np
+
+from .errors import InputError
+from .jit import njit, pjit, prange
 
 
 @njit
@@ -48,3 +51,48 @@ def select_rank(buf, lo, hi, k):
             lo = i
         else:
             break
+
+
+@njit
+def median_of(buf, n):
+    """Median of ``buf[:n]`` (``n >= 1``; reorders it): the middle value, or the mean of the two
+    middle values for even ``n`` (as ``numpy.median``, in ``buf``'s precision)."""
+    h = n // 2
+    select_rank(buf, 0, n - 1, h)
+    high = buf[h]
+    if n % 2 == 1:
+        return high
+    low = buf[0]  # the other middle value: the largest of the lower half
+    for j in range(1, h):
+        low = max(low, buf[j])
+    return 0.5 * (low + high)  # the sum in buf's precision, as numpy.mean of the two
+
+
+@pjit
+def _nanmedian_axis0_kernel(a, out):
+    n = a.shape[0]
+    m = a.shape[1]
+    for j in prange(m):
+        buf = np.empty(n, a.dtype)
+        k = 0
+        for i in range(n):
+            v = a[i, j]
+            if v == v:
+                buf[k] = v
+                k += 1
+        out[j] = median_of(buf, k) if k > 0 else np.nan
+
+
+def nanmedian_axis0(a: np.ndarray) -> np.ndarray:
+    """``numpy.nanmedian(a, axis=0)`` for float arrays (NaN where a column holds no value), without
+    its warning and without numpy's masked-array path, which sorts every column: on OSGM's guide
+    images and colour choice (a few to 40 views per cell) that path took about 5 % of a battery
+    scene's matching time."""
+    x = np.asarray(a)
+    if x.ndim < 1 or x.dtype not in (np.float32, np.float64):
+        raise InputError(f"nanmedian_axis0: expected a float32 or float64 array, got {x.dtype} {x.shape}")
+    rest = x.shape[1:]
+    out = np.full(int(np.prod(rest)), np.nan, x.dtype)
+    if x.shape[0] > 0 and out.size > 0:
+        _nanmedian_axis0_kernel(np.ascontiguousarray(x.reshape(x.shape[0], out.size)), out)
+    return out.reshape(rest)

@@ -58,7 +58,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..jit import njit
-from ..quickselect import select_rank
+from ..quickselect import median_of
 
 NO_LABEL = -1
 
@@ -147,14 +147,7 @@ def _add_disagreement(cost, colours, usable, tau, penalty, out):
             for b in range(B):
                 for j in range(n):
                     vals[j] = colours[idx[j], r, c, b]
-                h = n // 2
-                select_rank(vals, 0, n - 1, h)
-                low = vals[h]
-                if n % 2 == 0:  # the other middle value: the largest of the lower half
-                    low = vals[0]
-                    for j in range(1, h):
-                        low = max(low, vals[j])
-                med[b] = 0.5 * (low + vals[h])
+                med[b] = median_of(vals, n)
             agree = 0
             for j in range(n):
                 far[j] = False

@@ -33,7 +33,6 @@ never computed.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,7 +40,7 @@ import numpy as np
 from ..errors import InputError
 from ..geometry.camera import Camera
 from ..jit import pjit, prange
-from ..quickselect import select_rank
+from ..quickselect import nanmedian_axis0, select_rank
 from ..sgm import COST_MAX, aggregate, median_filter, multi_image_cost, select, valid_cells
 from .views import ImagePyramid, plane_map, project
 
@@ -463,9 +462,7 @@ def median_outliers(level: np.ndarray, size: int, tolerance: float = MEDIAN_TOLE
 
 def _median_view(samples: np.ndarray) -> np.ndarray:
     """Median over the views (NaN where none sees the cell)."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        return np.nanmedian(samples, axis=0).astype(np.float32)
+    return nanmedian_axis0(np.asarray(samples, np.float32))
 
 
 def _plane_need(search, lo, hi, gaps, a: int) -> np.ndarray:

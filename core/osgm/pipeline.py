@@ -28,7 +28,6 @@ import dataclasses
 import math
 import os
 import time
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -51,6 +50,7 @@ from ..parallel import (
     tile_run,
 )
 from ..progress import Progress, as_progress
+from ..quickselect import nanmedian_axis0
 from ..sgm import DEFAULT_P1, DEFAULT_P2, P2_MAX
 from .levels import MAX_BAND, LevelPlan, coarse_windows, plan_levels, refine_bands, refine_windows
 from .matching import TileParams, choose_images, sample_surface
@@ -532,9 +532,7 @@ def _colours(views, pyr, grid: RasterGrid, z: np.ndarray, cfg: OsgmConfig, progr
         col = sample_surface(imgs, tx0, ty0, grid.res, zt)  # (n, rows, cols, 3)
         scale = np.array([pyr.value_max(im.view.index) for im in imgs])
         lum = (col[..., 0] * 0.299 + col[..., 1] * 0.587 + col[..., 2] * 0.114) / scale[:, None, None]
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            med = np.nanmedian(lum, axis=0)
+        med = nanmedian_axis0(lum)
         agree = np.abs(lum - med[None]) <= 0.1
         X = tx0 + (np.arange(nc) + 0.5) * grid.res
         Y = ty0 - (np.arange(nr) + 0.5) * grid.res
