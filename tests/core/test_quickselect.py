@@ -1,4 +1,4 @@
-"""The shared rank selection and NaN-aware median of the compiled kernels (:mod:`truortho.core.quickselect`)."""
+"""The shared rank selection and NaN-aware median of the kernels (:mod:`truortho.core.quickselect`)."""
 
 import warnings
 
