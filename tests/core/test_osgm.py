@@ -1150,14 +1150,15 @@ def test_slope_trend_rejects_bad_input():
     assert slope_trend(np.zeros((4, 4)), 0.0, 0.25, 2).shape == (4, 4)
 
 
-def test_fill_unseen_gives_unseen_heights_the_median_of_the_measured():
+def test_fill_unseen_gives_unseen_heights_a_quantile_of_the_measured():
     """Inside a cell's band and outside its gap, the COST_MAX levels (fewer than two views) get the
-    median of the levels the cell measured; a cell that measured nothing, a cell that searches
-    nothing and the levels outside the band or in the gap keep what they had."""
+    lower quartile (by default) or the given quantile of the levels the cell measured; a cell that
+    measured nothing, a cell that searches nothing and the levels outside the band or in the gap
+    keep what they had."""
     from truortho.core.osgm.matching import UNSEEN_QUANTILE, fill_unseen
     from truortho.core.sgm import COST_MAX
 
-    assert UNSEEN_QUANTILE == 0.5
+    assert UNSEEN_QUANTILE == 0.25
     nd = 10
     cost = np.full((1, 4, nd), COST_MAX, np.uint16)
     cost[0, 0, 2:7] = [500, 100, COST_MAX, 300, 200]  # band 2..8, gap 7..7: measured 500 100 300 200
@@ -1167,12 +1168,16 @@ def test_fill_unseen_gives_unseen_heights_the_median_of_the_measured():
     hi = np.array([[11, 9, 3, 4]], np.int32)  # cell 3: lo > hi, nothing searched
     gaps = (np.array([[10, 1, 1, 1]]), np.array([[10, 0, 0, 0]]))
     before = cost.copy()
-    fill_unseen(cost, lo, hi, z0, gaps)
+    median = cost.copy()
+    fill_unseen(median, lo, hi, z0, gaps, quantile=0.5)
     want = before[0, 0].copy()
     want[[4, 8]] = 200  # the lower median of 100, 200, 300, 500; k = 7 is the gap, k = 0, 1, 9 outside
+    np.testing.assert_array_equal(median[0, 0], want)
+    fill_unseen(cost, lo, hi, z0, gaps)
+    want[[4, 8]] = 100  # rank int(0.25 * 3) = 0 of the four
     np.testing.assert_array_equal(cost[0, 0], want)
     np.testing.assert_array_equal(cost[0, 1], before[0, 1])  # measured nothing: no height
-    np.testing.assert_array_equal(cost[0, 2], np.r_[before[0, 2, :2], 400, before[0, 2, 3:]])  # lower median
+    np.testing.assert_array_equal(cost[0, 2], np.r_[before[0, 2, :2], 400, before[0, 2, 3:]])  # rank 0 of two
     np.testing.assert_array_equal(cost[0, 3], before[0, 3])
     for bad in (-0.1, 1.5, True, "0.5"):
         with pytest.raises(InputError, match="quantile must be a number in"):
