@@ -2,7 +2,9 @@
 
 Linear on average: the multi-view matching cost (:mod:`truortho.core.sgm.cost`) sums the smallest
 pair costs of a voxel with it, and the colour statistics of the true ortho
-(:mod:`truortho.core.ortho.color`) take group percentiles with it.
+(:mod:`truortho.core.ortho.color`) take group percentiles with it. :func:`median_of` (a kernel's
+median of a small buffer: the true ortho's agreement of the views) and :func:`nanmedian_axis0`
+(``numpy.nanmedian(a, axis=0)`` compiled: OSGM's median over the views) are built on it.
 """
 
 from __future__ import annotations

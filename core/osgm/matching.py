@@ -630,9 +630,8 @@ def fill_unseen(cost, lo, hi, z0, gaps=None, quantile: float = UNSEEN_QUANTILE) 
     (the quantile patched by a scratch script) against the median on master seeds 7, 808 and 2026:
     edge cells within 3 GSD up on 20 of 36 scenes (up to +0.69 points, seed 808 scene 0), down on
     4 by at most 0.35; flat3 within 0.15 points, NMAD within 0.004 GSD, completeness within 0.03
-    points; the cells of
-    *any* view count more than 10 GSD off (those a true ortho paints beside walls) down from
-    7.08 to 5.11 % (seed 7 scene 2), 4.11 -> 2.87 (7/3), 3.01 -> 2.21 (808/8), 4.77 -> 3.76
+    points; the cells of *any* view count more than 10 GSD off (those a true ortho paints beside
+    walls) down from 7.08 to 5.11 % (seed 7 scene 2), 4.11 -> 2.87 (7/3), 3.01 -> 2.21 (808/8), 4.77 -> 3.76
     (2026/9), 2.48 -> 1.86 (808/0), 2.73 -> 2.09 (2026/4), and a little more cells without a
     height (0.1-1.5 points, at the block's rim and under the tower). On seeds 13 and 99, run after
     the choice: edge3 up on 13 of 24 scenes, down on 3 (by at most 0.56 points, seed 99 scene 0),
