@@ -307,8 +307,19 @@ class OsgmResult:
             f"{s['tiles']} tiles; completeness {100 * s['completeness']:.2f} %, "
             f"mean confidence {s['mean_confidence']:.3f}; {s['seconds']:.1f} s"
         )
+        oblique = 0
         for sysd in s.get("systems", [])[1:]:
             text += f"; system {sysd['id']} ({sysd['name']}): {sysd['points']} points"
+            oblique += int(sysd["points"])
+        if s["completeness"] <= 0.0:
+            # an empty DSM reads like a failure; say why and where the result is
+            if oblique:
+                text += (". The DSM is empty: no pair of photos matched the ground from above (photos "
+                         "taken sideways, as of a facade); the oblique systems' points are the result "
+                         "(POINT_CLOUD)")  # fmt: skip
+            else:
+                text += (". Nothing matched: check that Z_MIN/Z_MAX enclose the surface and that the "
+                         "extent is seen by at least two photos")  # fmt: skip
         return text
 
 

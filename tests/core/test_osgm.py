@@ -1224,3 +1224,22 @@ def test_an_unseen_roof_corner_takes_the_roof_height_not_a_seen_one():
     assert np.mean(right[True]) > 0.95
     assert np.mean(right[False]) < 0.5
     assert np.mean(np.abs(np.nan_to_num(level, nan=-99) - true)[~roof] <= 1) > 0.99  # the ground
+
+
+def test_summary_explains_an_empty_dsm():
+    """An empty DSM reads like a failure: the summary says why, and where the result of a facade
+    block is (the oblique systems' points); a DSM with cells gets no such sentence."""
+    from truortho.core.osgm import OsgmResult
+
+    grid = RasterGrid(0.0, 10.0, 1.0, 10, 10, None)
+    base = {"cols": 10, "rows": 10, "resolution": 1.0, "z_step": 1.0, "z_min": 0.0, "z_max": 5.0,
+            "z_source": "Z_MIN/Z_MAX", "levels": 1, "tiles": 1, "mean_confidence": 0.0,
+            "seconds": 1.0}  # fmt: skip
+    nadir = {"id": 0, "name": "nadir", "points": 0}
+    side = {"id": 1, "name": "oblique towards azimuth 324 deg", "points": 1234}
+    facade = OsgmResult(grid, dict(base, completeness=0.0, systems=[nadir, side])).summary()
+    assert "DSM is empty" in facade and "POINT_CLOUD" in facade and "1234 points" in facade
+    nothing = OsgmResult(grid, dict(base, completeness=0.0, systems=[nadir])).summary()
+    assert "Nothing matched" in nothing and "Z_MIN/Z_MAX" in nothing
+    fine = OsgmResult(grid, dict(base, completeness=0.97, systems=[nadir, side])).summary()
+    assert "empty" not in fine and "Nothing" not in fine and "97.00 %" in fine
