@@ -29,7 +29,7 @@ import math
 import os
 import time
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import ClassVar
 
@@ -110,7 +110,9 @@ class OsgmConfig:
         where the others leave a part with fewer than two views (the rim of a block, which
         only obliques see twice); 0 = never.
     oblique : {"none", "auto"}
-        ``"auto"``: additional reference systems for groups of oblique images.
+        ``"auto"``: additional reference systems for groups of oblique images. Their points
+        go to the point cloud only (the DSM is the nadir system's), so :func:`run_osgm`
+        skips them, and says so, when ``outputs.point_cloud`` is None.
     oblique_group_angle : float
         Largest angle between the viewing directions of the images of one
         oblique system (degrees).
@@ -612,6 +614,12 @@ def run_osgm(
     if outputs is None:
         raise InputError("DSM: an output path is required")
     outputs.validate()
+    if cfg.oblique != "none" and outputs.point_cloud is None:
+        # the oblique systems' only product is the point cloud (the DSM is the nadir system's, the same
+        # with or without them): without POINT_CLOUD their matching would be lost work
+        cfg = replace(cfg, oblique="none")
+        progress.update(0.0, "OBLIQUE=auto without a POINT_CLOUD output: the oblique reference systems "
+                             "are skipped (their points go only to the point cloud)")  # fmt: skip
     o = as_orientation(orientation)
     o.validate()
     if o.crs is None:

@@ -259,7 +259,7 @@ HELP: dict[str, dict] = {
             "grid's axes and diagonals).",
             "OBLIQUE": "none: one nadir reference system (the DSM). auto: groups of oblique images also get "
             "reference systems along their viewing directions, whose points go to the point cloud with "
-            "their 'system' id.",
+            "their 'system' id (without a POINT_CLOUD output they are skipped: the DSM is the same).",
             "P1": "Penalty for a change of one height step between neighbouring cells, in cost units "
             "(unrelated image windows cost 1023); empty = 256.",
             "P2": "Penalty for a larger height jump, above P1 and at most 3072; empty = 2048 (a jump then "

@@ -342,6 +342,15 @@ def test_obliques_add_facade_points(tmp_path):
     a, _, _ = read_raster(tmp_path / "dsm_auto.tif")
     b, _, _ = read_raster(tmp_path / "dsm_none.tif")
     assert np.array_equal(np.isnan(a), np.isnan(b)) and np.nanmax(np.abs(a - b)) == 0
+    # so without a point cloud to write them to, the oblique systems are skipped, and said so
+    said = []
+    r = run_osgm(scene.orientation, OsgmConfig(resolution=res, oblique="auto"), scene.extent_world(),
+                 OsgmOutputs(dsm=tmp_path / "dsm_auto_only.tif"), tmp_path,
+                 progress=CallbackProgress(lambda f, m: said.append(m)))  # fmt: skip
+    assert len(r.stats["systems"]) == 1
+    assert any(m and "oblique reference systems are skipped" in m for m in said)
+    c, _, _ = read_raster(tmp_path / "dsm_auto_only.tif")
+    assert np.array_equal(np.isnan(c), np.isnan(b)) and np.nanmax(np.abs(c - b)) == 0
 
 
 def _wall_samples(scene, step):
