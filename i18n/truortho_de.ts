@@ -849,77 +849,77 @@
             <translation>Fotos zum True Orthophoto (gesamte Prozesskette)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="101" />
+            <location filename="../processing/algorithms/pipeline.py" line="103" />
             <source>DSM (filtered)</source>
             <translation>DOM (gefiltert)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="104" />
+            <location filename="../processing/algorithms/pipeline.py" line="106" />
             <source>True orthophoto</source>
             <translation>True Orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="105" />
+            <location filename="../processing/algorithms/pipeline.py" line="107" />
             <source>Occlusion mask</source>
             <translation>Verdeckungsmaske</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="106" />
+            <location filename="../processing/algorithms/pipeline.py" line="108" />
             <source>Seamlines</source>
             <translation>Nahtlinien</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="81" />
+            <location filename="../processing/algorithms/pipeline.py" line="83" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Auflösung des DOM und des True Orthophotos (m, 0 = Bodenpixelgröße)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="90" />
+            <location filename="../processing/algorithms/pipeline.py" line="92" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Eine vorhandene orientation.json im Ausgabeordner wiederverwenden</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="121" />
+            <location filename="../processing/algorithms/pipeline.py" line="123" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES: geben Sie den Ordner der Fotos an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="137" />
+            <location filename="../processing/algorithms/pipeline.py" line="139" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER: geben Sie einen Ordner für die Produkte an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="147" />
+            <location filename="../processing/algorithms/pipeline.py" line="149" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION: positive Anzahl Meter oder 0 erwartet</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="187" />
+            <location filename="../processing/algorithms/pipeline.py" line="189" />
             <source>DSM (TruOrtho)</source>
             <translation>DOM (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="188" />
+            <location filename="../processing/algorithms/pipeline.py" line="190" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>True Orthophoto (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="189" />
+            <location filename="../processing/algorithms/pipeline.py" line="191" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Verdeckung (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="190" />
+            <location filename="../processing/algorithms/pipeline.py" line="192" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Nahtlinien (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="171" />
+            <location filename="../processing/algorithms/pipeline.py" line="173" />
             <source>Tiles ran on: {}</source>
             <translation>Kacheln berechnet auf: {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="170" />
+            <location filename="../processing/algorithms/pipeline.py" line="172" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{}: {:.1f} s, Spitze {:.0f} MB; {}</translation>
         </message>
@@ -994,102 +994,102 @@
             <translation>EPT-Datensatz: {} (als Punktwolken-Layer hinzufügen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="91" />
+            <location filename="../processing/algorithms/trueortho.py" line="93" />
             <source>Surface: DSM raster or mesh</source>
             <translation>Oberfläche: DOM-Raster oder Dreiecksnetz</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="96" />
+            <location filename="../processing/algorithms/trueortho.py" line="98" />
             <source>Extent (default: the surface's)</source>
             <translation>Ausdehnung (Standard: die der Oberfläche)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="101" />
+            <location filename="../processing/algorithms/trueortho.py" line="103" />
             <source>Resolution (CRS units; 0 = the surface's cell size)</source>
             <translation>Auflösung (KBS-Einheiten; 0 = Zellgröße der Oberfläche)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="108" />
+            <location filename="../processing/algorithms/trueortho.py" line="110" />
             <source>Output CRS (default: the orientation's)</source>
             <translation>Ausgabe-KBS (Standard: das der Orientierung)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="112" />
+            <location filename="../processing/algorithms/trueortho.py" line="114" />
             <source>Colour correction</source>
             <translation>Farbausgleich</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="118" />
+            <location filename="../processing/algorithms/trueortho.py" line="120" />
             <source>Remove vignetting (with the colour correction)</source>
             <translation>Vignettierung entfernen (mit der Farbkorrektur)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="127" />
+            <location filename="../processing/algorithms/trueortho.py" line="129" />
             <source>Maximum off-nadir viewing angle (degrees)</source>
             <translation>Größter Blickwinkel zum Nadir (Grad)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="137" />
+            <location filename="../processing/algorithms/trueortho.py" line="139" />
             <source>Blend width across seamlines (cells)</source>
             <translation>Überblendungsbreite an den Nahtlinien (Zellen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="158" />
+            <location filename="../processing/algorithms/trueortho.py" line="160" />
             <source>Compression of the orthophoto</source>
             <translation>Kompression des Orthophotos</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="171" />
+            <location filename="../processing/algorithms/trueortho.py" line="173" />
             <source>JPEG quality</source>
             <translation>JPEG-Qualität</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="183" />
+            <location filename="../processing/algorithms/trueortho.py" line="185" />
             <source>Source image index</source>
             <translation>Index des Quellbilds</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="194" />
+            <location filename="../processing/algorithms/trueortho.py" line="196" />
             <source>Seamlines (source image regions)</source>
             <translation>Nahtlinien (Bereiche der Quellbilder)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="209" />
+            <location filename="../processing/algorithms/trueortho.py" line="211" />
             <source>SURFACE: give a DSM raster or a mesh file</source>
             <translation>SURFACE: geben Sie ein DOM-Raster oder eine Netzdatei an</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="92" />
+            <location filename="../processing/algorithms/trueortho.py" line="94" />
             <source>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;All files (*.*)</source>
             <translation>Oberflächen (*.tif *.tiff *.vrt *.ply *.obj);;Alle Dateien (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="245" />
+            <location filename="../processing/algorithms/trueortho.py" line="247" />
             <source>{} x {} cells, {} images used, coverage {:.2%}, {} cells seen by no image</source>
             <translation>{} x {} Zellen, {} Bilder verwendet, Abdeckung {:.2%}, {} Zellen von keinem Bild gesehen</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="160" />
+            <location filename="../processing/algorithms/trueortho.py" line="162" />
             <source>DEFLATE (lossless, read by every GIS)</source>
             <translation>DEFLATE (verlustfrei, von jedem GIS gelesen)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="161" />
+            <location filename="../processing/algorithms/trueortho.py" line="163" />
             <source>ZSTD (lossless, fastest to write, larger)</source>
             <translation>ZSTD (verlustfrei, am schnellsten geschrieben, größer)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="162" />
+            <location filename="../processing/algorithms/trueortho.py" line="164" />
             <source>LZW (lossless)</source>
             <translation>LZW (verlustfrei)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="163" />
+            <location filename="../processing/algorithms/trueortho.py" line="165" />
             <source>JPEG (lossy, 8-bit RGB images only; alpha becomes a mask)</source>
             <translation>JPEG (verlustbehaftet, nur 8-Bit-RGB-Bilder; Alpha wird zur Maske)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="252" />
+            <location filename="../processing/algorithms/trueortho.py" line="254" />
             <source>colour correction ({}): disagreement between photos, median {:.2f} -&gt; {:.2f}</source>
             <translation>Farbkorrektur ({}): Abweichung zwischen den Fotos, Median {:.2f} -&gt; {:.2f}</translation>
         </message>
@@ -1495,8 +1495,8 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="260" />
-            <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
-            <translation>none: ein Nadir-Referenzsystem (das DOM). auto: Gruppen von Schrägbildern erhalten zusätzlich Referenzsysteme entlang ihrer Blickrichtungen, deren Punkte mit ihrer 'system'-Kennung in die Punktwolke gehen.</translation>
+            <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id (without a POINT_CLOUD output they are skipped: the DSM is the same).</source>
+            <translation>none: ein Nadir-Referenzsystem (das DOM). auto: Gruppen von Schrägbildern erhalten zusätzlich Referenzsysteme entlang ihrer Blickrichtungen, deren Punkte mit ihrer 'system'-Kennung in die Punktwolke gehen (ohne Ausgabe POINT_CLOUD werden sie übersprungen: das DOM ist dasselbe).</translation>
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="263" />
@@ -2347,6 +2347,10 @@
             <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>Der Algorithmus {} ist in dieser Version nicht verfügbar.</translation>
+        </message>
+        <message>
+            <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
+            <translation type="obsolete">none: ein Nadir-Referenzsystem (das DOM). auto: Gruppen von Schrägbildern erhalten zusätzlich Referenzsysteme entlang ihrer Blickrichtungen, deren Punkte mit ihrer 'system'-Kennung in die Punktwolke gehen.</translation>
         </message>
         <message>
             <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>

@@ -849,77 +849,77 @@
             <translation>Des photos à l'orthophoto vraie (chaîne complète)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="101" />
+            <location filename="../processing/algorithms/pipeline.py" line="103" />
             <source>DSM (filtered)</source>
             <translation>MNS (filtré)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="104" />
+            <location filename="../processing/algorithms/pipeline.py" line="106" />
             <source>True orthophoto</source>
             <translation>Orthophoto vraie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="105" />
+            <location filename="../processing/algorithms/pipeline.py" line="107" />
             <source>Occlusion mask</source>
             <translation>Masque d'occultation</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="106" />
+            <location filename="../processing/algorithms/pipeline.py" line="108" />
             <source>Seamlines</source>
             <translation>Lignes de raccord</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="81" />
+            <location filename="../processing/algorithms/pipeline.py" line="83" />
             <source>Resolution of the DSM and the true orthophoto (m, 0 = ground sample distance)</source>
             <translation>Résolution du MNS et de l'orthophoto vraie (m, 0 = taille du pixel au sol)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="90" />
+            <location filename="../processing/algorithms/pipeline.py" line="92" />
             <source>Reuse an existing orientation.json in the output folder</source>
             <translation>Réutiliser un orientation.json existant dans le dossier de sortie</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="121" />
+            <location filename="../processing/algorithms/pipeline.py" line="123" />
             <source>IMAGES: give the folder of the photos</source>
             <translation>IMAGES : indiquez le dossier des photos</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="137" />
+            <location filename="../processing/algorithms/pipeline.py" line="139" />
             <source>OUTPUT_FOLDER: give a folder for the products</source>
             <translation>OUTPUT_FOLDER : indiquez un dossier pour les produits</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="147" />
+            <location filename="../processing/algorithms/pipeline.py" line="149" />
             <source>RESOLUTION: expected a positive number of metres or 0</source>
             <translation>RESOLUTION : nombre positif de mètres ou 0 attendu</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="187" />
+            <location filename="../processing/algorithms/pipeline.py" line="189" />
             <source>DSM (TruOrtho)</source>
             <translation>MNS (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="188" />
+            <location filename="../processing/algorithms/pipeline.py" line="190" />
             <source>True orthophoto (TruOrtho)</source>
             <translation>Orthophoto vraie (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="189" />
+            <location filename="../processing/algorithms/pipeline.py" line="191" />
             <source>Occlusion (TruOrtho)</source>
             <translation>Occultation (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="190" />
+            <location filename="../processing/algorithms/pipeline.py" line="192" />
             <source>Seamlines (TruOrtho)</source>
             <translation>Lignes de raccord (TruOrtho)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="171" />
+            <location filename="../processing/algorithms/pipeline.py" line="173" />
             <source>Tiles ran on: {}</source>
             <translation>Tuiles calculées sur : {}</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/pipeline.py" line="170" />
+            <location filename="../processing/algorithms/pipeline.py" line="172" />
             <source>{}: {:.1f} s, peak {:.0f} MB; {}</source>
             <translation>{} : {:.1f} s, pic {:.0f} Mo ; {}</translation>
         </message>
@@ -994,102 +994,102 @@
             <translation>Jeu de données EPT : {} (à ajouter comme couche nuage de points)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="91" />
+            <location filename="../processing/algorithms/trueortho.py" line="93" />
             <source>Surface: DSM raster or mesh</source>
             <translation>Surface : raster MNS ou maillage</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="96" />
+            <location filename="../processing/algorithms/trueortho.py" line="98" />
             <source>Extent (default: the surface's)</source>
             <translation>Emprise (par défaut : celle de la surface)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="101" />
+            <location filename="../processing/algorithms/trueortho.py" line="103" />
             <source>Resolution (CRS units; 0 = the surface's cell size)</source>
             <translation>Résolution (unités du SCR ; 0 = taille de cellule de la surface)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="108" />
+            <location filename="../processing/algorithms/trueortho.py" line="110" />
             <source>Output CRS (default: the orientation's)</source>
             <translation>SCR de sortie (par défaut : celui de l'orientation)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="112" />
+            <location filename="../processing/algorithms/trueortho.py" line="114" />
             <source>Colour correction</source>
             <translation>Correction colorimétrique</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="118" />
+            <location filename="../processing/algorithms/trueortho.py" line="120" />
             <source>Remove vignetting (with the colour correction)</source>
             <translation>Supprimer le vignettage (avec la correction colorimétrique)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="127" />
+            <location filename="../processing/algorithms/trueortho.py" line="129" />
             <source>Maximum off-nadir viewing angle (degrees)</source>
             <translation>Angle de visée maximal par rapport au nadir (degrés)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="137" />
+            <location filename="../processing/algorithms/trueortho.py" line="139" />
             <source>Blend width across seamlines (cells)</source>
             <translation>Largeur du fondu aux lignes de raccord (cellules)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="158" />
+            <location filename="../processing/algorithms/trueortho.py" line="160" />
             <source>Compression of the orthophoto</source>
             <translation>Compression de l'orthophoto</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="171" />
+            <location filename="../processing/algorithms/trueortho.py" line="173" />
             <source>JPEG quality</source>
             <translation>Qualité JPEG</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="183" />
+            <location filename="../processing/algorithms/trueortho.py" line="185" />
             <source>Source image index</source>
             <translation>Index de l'image source</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="194" />
+            <location filename="../processing/algorithms/trueortho.py" line="196" />
             <source>Seamlines (source image regions)</source>
             <translation>Lignes de raccord (zones des images sources)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="209" />
+            <location filename="../processing/algorithms/trueortho.py" line="211" />
             <source>SURFACE: give a DSM raster or a mesh file</source>
             <translation>SURFACE : indiquez un raster MNS ou un fichier de maillage</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="92" />
+            <location filename="../processing/algorithms/trueortho.py" line="94" />
             <source>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;All files (*.*)</source>
             <translation>Surfaces (*.tif *.tiff *.vrt *.ply *.obj);;Tous les fichiers (*.*)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="245" />
+            <location filename="../processing/algorithms/trueortho.py" line="247" />
             <source>{} x {} cells, {} images used, coverage {:.2%}, {} cells seen by no image</source>
             <translation>{} x {} cellules, {} images utilisées, couverture {:.2%}, {} cellules vues par aucune image</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="160" />
+            <location filename="../processing/algorithms/trueortho.py" line="162" />
             <source>DEFLATE (lossless, read by every GIS)</source>
             <translation>DEFLATE (sans perte, lu par tous les SIG)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="161" />
+            <location filename="../processing/algorithms/trueortho.py" line="163" />
             <source>ZSTD (lossless, fastest to write, larger)</source>
             <translation>ZSTD (sans perte, écriture la plus rapide, plus volumineux)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="162" />
+            <location filename="../processing/algorithms/trueortho.py" line="164" />
             <source>LZW (lossless)</source>
             <translation>LZW (sans perte)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="163" />
+            <location filename="../processing/algorithms/trueortho.py" line="165" />
             <source>JPEG (lossy, 8-bit RGB images only; alpha becomes a mask)</source>
             <translation>JPEG (avec perte, images RVB 8 bits seulement ; l'alpha devient un masque)</translation>
         </message>
         <message>
-            <location filename="../processing/algorithms/trueortho.py" line="252" />
+            <location filename="../processing/algorithms/trueortho.py" line="254" />
             <source>colour correction ({}): disagreement between photos, median {:.2f} -&gt; {:.2f}</source>
             <translation>correction colorimétrique ({}) : écart entre les photos, médiane {:.2f} -&gt; {:.2f}</translation>
         </message>
@@ -1495,8 +1495,8 @@
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="260" />
-            <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
-            <translation>none : un seul système de référence au nadir (le MNS). auto : les groupes d'images obliques reçoivent en plus des systèmes de référence orientés selon leurs directions de visée, dont les points vont dans le nuage de points avec leur identifiant 'system'.</translation>
+            <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id (without a POINT_CLOUD output they are skipped: the DSM is the same).</source>
+            <translation>none : un seul système de référence au nadir (le MNS). auto : les groupes d'images obliques reçoivent en plus des systèmes de référence orientés selon leurs directions de visée, dont les points vont dans le nuage de points avec leur identifiant 'system' (sans sortie POINT_CLOUD, ils sont omis : le MNS est le même).</translation>
         </message>
         <message>
             <location filename="../processing/help/__init__.py" line="263" />
@@ -2347,6 +2347,10 @@
             <location filename="../truortho_plugin/plugin.py" line="133" />
             <source>The algorithm {} is not available in this version.</source>
             <translation>L'algorithme {} n'est pas disponible dans cette version.</translation>
+        </message>
+        <message>
+            <source>none: one nadir reference system (the DSM). auto: groups of oblique images also get reference systems along their viewing directions, whose points go to the point cloud with their 'system' id.</source>
+            <translation type="obsolete">none : un seul système de référence au nadir (le MNS). auto : les groupes d'images obliques reçoivent en plus des systèmes de référence orientés selon leurs directions de visée, dont les points vont dans le nuage de points avec leur identifiant 'system'.</translation>
         </message>
         <message>
             <source>Computes a true orthophoto from oriented images and a surface (a DSM raster such as OSGM's, or a PLY/OBJ mesh): every cell is coloured from an image that really sees it, found with a depth buffer of the surface per image (DSM cells as flat tops with vertical walls at height steps, or the mesh's triangles; frustum and back-face culling). Among the images that see a cell the one with the finest effective ground resolution (distance and incidence on the surface) is preferred; roofs are textured from one image each and seamlines follow height discontinuities and avoid places where the images disagree (label smoothing), with feathering across seams only between images that both see the cells. Per-image colour corrections in CIE L*a*b* (per-band gain/offset for non-RGB data) are estimated by least squares from cells seen by several images. Cells no image sees get alpha 0 and appear in the occlusion mask. Any band count and data type of the images is kept (RGB, 16-bit panchromatic, thermal). Processing runs by tiles with bounded memory; progress and cancel per tile.</source>
