@@ -50,7 +50,7 @@ def main(argv=None) -> int:
     floors = [float(v) for v in args.floor.split(",") if v]
     for name in ("orientation.json", "dsm.tif"):
         if not os.path.isfile(os.path.join(args.products, name)):
-            raise SystemExit(f"{args.products}: {name} not found (a products folder of real_blocks.py --keep)")
+            raise SystemExit(f"{args.products}: {name} not found (real_blocks.py --keep keeps it)")
 
     from scipy.ndimage import median_filter
 
