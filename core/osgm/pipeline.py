@@ -321,7 +321,8 @@ class OsgmResult:
                          "(POINT_CLOUD)")  # fmt: skip
             else:
                 text += (". Nothing matched: check that Z_MIN/Z_MAX enclose the surface and that the "
-                         "extent is seen by at least two photos")  # fmt: skip
+                         "extent is seen by at least two photos; photos taken sideways (a facade) "
+                         "need OBLIQUE=auto and a POINT_CLOUD output")  # fmt: skip
         return text
 
 

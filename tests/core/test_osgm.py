@@ -1249,6 +1249,6 @@ def test_summary_explains_an_empty_dsm():
     facade = OsgmResult(grid, dict(base, completeness=0.0, systems=[nadir, side])).summary()
     assert "DSM is empty" in facade and "POINT_CLOUD" in facade and "1234 points" in facade
     nothing = OsgmResult(grid, dict(base, completeness=0.0, systems=[nadir])).summary()
-    assert "Nothing matched" in nothing and "Z_MIN/Z_MAX" in nothing
+    assert "Nothing matched" in nothing and "Z_MIN/Z_MAX" in nothing and "POINT_CLOUD" in nothing
     fine = OsgmResult(grid, dict(base, completeness=0.97, systems=[nadir, side])).summary()
     assert "empty" not in fine and "Nothing" not in fine and "97.00 %" in fine
