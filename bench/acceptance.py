@@ -706,7 +706,7 @@ def warm_up(work: str, log) -> None:
     15 s instead of 7 after an edit; fountain-P11's ``truortho:osgm`` 132-134 s with a cold cache
     against 81-84 s warm (in-process, at 8d51276 and 9c73f60). The compiled kernels are cached
     next to the sources, so ``qgis_process`` runs of the same checkout load them too."""
-    from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho
+    from truortho.core.ortho.pipeline import true_ortho
     from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
     from truortho.core.synthetic import SceneConfig, make_scene
 
@@ -717,8 +717,7 @@ def warm_up(work: str, log) -> None:
     scene.write(folder)
     out = OsgmOutputs(dsm=os.path.join(folder, "osgm.tif"))
     run_osgm(scene.orientation, OsgmConfig(resolution=cfg.gsd), scene.extent_world(), out, folder)
-    true_ortho(scene.orientation, out.dsm, os.path.join(folder, "ortho.tif"), config=TrueOrthoConfig(),
-               image_root=folder)  # fmt: skip
+    true_ortho(scene.orientation, out.dsm, os.path.join(folder, "ortho.tif"), image_root=folder)
     shutil.rmtree(folder, ignore_errors=True)
     log(f"warm-up (compiled kernels loaded or compiled): {time.perf_counter() - t:.1f} s")
 

@@ -47,7 +47,14 @@ def main(argv=None) -> int:
     ap.add_argument("--floor", default="0", help="comma-separated floors of the saturation scale (0: none)")
     args = ap.parse_args(argv)
     (r0, r1), (c0, c1) = _span(args.rows, "rows"), _span(args.cols, "cols")
-    floors = [float(v) for v in args.floor.split(",") if v]
+    if args.margin < 0:
+        raise SystemExit(f"--margin: expected cells >= 0, got {args.margin}")
+    try:
+        floors = [float(v) for v in args.floor.split(",") if v]
+    except ValueError:
+        raise SystemExit(f"--floor: expected comma-separated numbers >= 0, got {args.floor!r}") from None
+    if not floors or min(floors) < 0:
+        raise SystemExit(f"--floor: expected comma-separated numbers >= 0, got {args.floor!r}")
     for name in ("orientation.json", "dsm.tif"):
         if not os.path.isfile(os.path.join(args.products, name)):
             raise SystemExit(f"{args.products}: {name} not found (real_blocks.py --keep keeps it)")

@@ -294,6 +294,11 @@ class OsgmOutputs:
         if len(set(given)) != len(given):
             raise InputError("outputs: two outputs have the same path")
 
+    @property
+    def wants_colours(self) -> bool:
+        """Whether the nadir cells need colours: only the orthoimage and the point cloud use them."""
+        return self.orthoimage is not None or self.point_cloud is not None
+
 
 @dataclass
 class OsgmResult:
@@ -804,7 +809,7 @@ def _run_systems(
         )  # fmt: skip
     surf = _match_surface(
         o, cfg, grid, local, pyr, executor, cache, cache_base, zmin, zmax, dz, z_surface, progress,
-        outputs.point_cloud is not None, outputs.orthoimage is not None or outputs.point_cloud is not None,
+        outputs.point_cloud is not None, outputs.wants_colours,
     )  # fmt: skip
     dsm, conf = surf.dsm, surf.conf
     sys_stats = _system_stats(surf.systems, int(np.isfinite(dsm).sum()), [len(c[0]) for c in surf.clouds],
@@ -963,8 +968,7 @@ def _run_chunked(
             sub = SubProgress(progress, 0.95 * k / len(chunks), 0.95 * (k + 1) / len(chunks))
             surf = _match_surface(
                 o, cfg, ch.outer_grid(grid), ch.outer_grid(local), pyr, executor, cache, cache_base,
-                zmin, zmax, dz, z_surface, sub, outputs.point_cloud is not None,
-                outputs.orthoimage is not None or outputs.point_cloud is not None,
+                zmin, zmax, dz, z_surface, sub, outputs.point_cloud is not None, outputs.wants_colours,
             )  # fmt: skip
             ins = ch.inner_slices
             dsm, conf = surf.dsm[ins], surf.conf[ins]
