@@ -8,10 +8,16 @@ rendered once into ``--keep DIR`` (with the truth masks the figures need); later
         [--z-step-factor 1.5] [--uniqueness 0.99] [--set refine_edges=False ...]
 
 Prints, per scene, the OSGM wall time and the figures of ``acceptance.dsm_figures`` (completeness,
-NMAD in GSD, flat3, edge3), writes them to ``DIR/<tag>.json`` and each DSM to
-``DIR/scene_NN/osgm_<tag>.tif``, so that two variants of the code can be compared cell by cell.
+NMAD in GSD, flat3, edge3) and the DSM's roughness (1.4826 x the median departure from its 9 x 9
+median surface away from edges, in GSD: noise, where NMAD also counts offsets), writes them to
+``DIR/<tag>.json`` and each DSM to ``DIR/scene_NN/osgm_<tag>.tif``, so that two variants of the
+code can be compared cell by cell.
 The figures cited in ``core/osgm/levels.py`` and ``core/osgm/pipeline.py`` were measured with this
 loop (scenes 1-11 for times: the first scene also loads the compiled kernels).
+
+``--rotate-px X`` matches with every photo turned by a random rotation of X pixels (normal, sigma
+per axis, at the photo's focal length; drawn per scene, the same on every run): cameras as a
+bundle adjustment leaves them instead of the exact ones.
 """
 
 from __future__ import annotations
@@ -55,6 +61,30 @@ def _scene(i: int, seed: int, folder: str) -> dict:
         return pickle.load(fh)
 
 
+def _rotated(orientation, px: float, index: int):
+    """A copy of ``orientation`` with every photo turned by a random rotation of ``px`` pixels."""
+    import copy
+
+    from scipy.spatial.transform import Rotation
+
+    o = copy.deepcopy(orientation)
+    rng = np.random.default_rng(1000 + index)
+    for im in o.images:
+        f = float(o.cameras[im.camera].fx)
+        im.R = Rotation.from_rotvec(rng.normal(0.0, px / f, 3)).as_matrix() @ np.asarray(im.R)
+    return o
+
+
+def _roughness(dsm: np.ndarray, edge: np.ndarray) -> float:
+    """1.4826 x the median |departure from the 9 x 9 median surface| over the cells off ``edge``."""
+    from scipy.ndimage import median_filter
+
+    fill = float(np.nanmedian(dsm)) if np.isfinite(dsm).any() else 0.0
+    dev = dsm - median_filter(np.nan_to_num(dsm, nan=fill), 9)
+    m = ~edge & np.isfinite(dev)
+    return float(1.4826 * np.median(np.abs(dev[m]))) if m.any() else float("nan")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--keep", required=True, help="folder of the cached scenes and the results")
@@ -64,6 +94,8 @@ def main(argv=None) -> int:
     ap.add_argument("--z-step-factor", type=float, default=0.0,
                     help="Z_STEP as a multiple of the cell (0: the default)")  # fmt: skip
     ap.add_argument("--uniqueness", type=float, default=None, help="OsgmConfig.uniqueness (default its own)")
+    ap.add_argument("--rotate-px", type=float, default=0.0,
+                    help="turn every photo by a random rotation of so many px (sigma per axis)")  # fmt: skip
     ap.add_argument(
         "--set",
         action="append",
@@ -88,6 +120,8 @@ def main(argv=None) -> int:
             extra[name] = ast.literal_eval(value)
         except (ValueError, SyntaxError):
             ap.error(f"--set {item!r}: {value!r} is not a Python literal")
+    if not (args.rotate_px >= 0.0 and np.isfinite(args.rotate_px)):
+        ap.error(f"--rotate-px: expected pixels >= 0, got {args.rotate_px}")
     results = {}
     for i in indices:
         folder = os.path.join(args.keep, f"scene_{i:02d}")
@@ -97,14 +131,17 @@ def main(argv=None) -> int:
                           confidence=os.path.join(folder, f"conf_{args.tag}.tif"))  # fmt: skip
         cfg = OsgmConfig(resolution=d["res"], z_min=d["zlo"], z_max=d["zhi"],
                          z_step=(args.z_step_factor * d["res"]) or None, **extra)  # fmt: skip
+        o = _rotated(d["o"], args.rotate_px, i) if args.rotate_px > 0 else d["o"]
         t = time.perf_counter()
-        run_osgm(d["o"], cfg, d["ext"], out, folder)
+        run_osgm(o, cfg, d["ext"], out, folder)
         seconds = time.perf_counter() - t
         dsm, _, _ = read_raster(out.dsm)
         f = dict(dsm_figures(dsm, truth, d["nvis"] >= 2, d["edge"], d["gsd"]), seconds=seconds)
+        f["roughness_gsd"] = _roughness(dsm, d["edge"]) / d["gsd"]
         results[str(i)] = f
         print(f"{args.tag} scene {i}: {seconds:6.1f} s, completeness {f['completeness']:.4f}, "
-              f"nmad {f['nmad_gsd']:.3f} GSD, flat3 {f['flat3']:.4f}, edge3 {f['edge3']:.4f}",
+              f"nmad {f['nmad_gsd']:.3f} GSD, flat3 {f['flat3']:.4f}, edge3 {f['edge3']:.4f}, "
+              f"roughness {f['roughness_gsd']:.3f} GSD",
               flush=True)  # fmt: skip
     with open(os.path.join(args.keep, f"{args.tag}.json"), "w") as fh:
         json.dump(results, fh, indent=1)
