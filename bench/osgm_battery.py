@@ -17,7 +17,9 @@ loop (scenes 1-11 for times: the first scene also loads the compiled kernels).
 
 ``--rotate-px X`` matches with every photo turned by a random rotation of X pixels (normal, sigma
 per axis, at the photo's focal length; drawn per scene, the same on every run): cameras as a
-bundle adjustment leaves them instead of the exact ones.
+bundle adjustment leaves them instead of the exact ones. ``--scene FIELD=VALUE`` renders every
+scene with a ``SceneConfig`` field changed (``optics_blur=2.0``, ``crop_share=0.5``), into its own
+``--keep`` folder.
 """
 
 from __future__ import annotations
@@ -35,18 +37,22 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def _scene(i: int, seed: int, folder: str) -> dict:
-    """The cached scene ``i`` (rendered and pickled on first use)."""
+def _scene(i: int, seed: int, folder: str, changes: dict | None = None) -> dict:
+    """The cached scene ``i`` (rendered and pickled on first use), with ``changes`` to its
+    ``SceneConfig`` (a folder holds the scene of one set of changes only)."""
+    import dataclasses
+
     from acceptance import draw_config, dsm_masks
 
     from truortho.core.rasterio_io import read_raster
 
+    changes = dict(changes or {})
     path = os.path.join(folder, "scene.pkl")
     if not os.path.exists(path):
         from truortho.core.ortho import evaluate as ev
         from truortho.core.synthetic import make_scene
 
-        cfg = draw_config(i, seed)
+        cfg = dataclasses.replace(draw_config(i, seed), **changes)
         scene = make_scene(cfg)
         scene.write(folder)
         truth, grid, _ = read_raster(os.path.join(folder, "dsm.tif"))
@@ -54,11 +60,18 @@ def _scene(i: int, seed: int, folder: str) -> dict:
             "o": scene.orientation, "res": grid.res, "ext": scene.extent_world(), "gsd": cfg.gsd,
             "zlo": float(np.nanmin(truth)) - 5.0, "zhi": float(np.nanmax(truth)) + 5.0,
             "nvis": ev.truth_view_counts(scene, grid, tol=0.05), "edge": dsm_masks(truth, cfg.gsd, grid.res),
+            "scene_changes": changes,
         }  # fmt: skip
         with open(path, "wb") as fh:
             pickle.dump(d, fh)
     with open(path, "rb") as fh:
-        return pickle.load(fh)
+        d = pickle.load(fh)
+    if d.get("scene_changes", {}) != changes:
+        raise SystemExit(
+            f"{folder}: rendered with the scene changes {d.get('scene_changes', {})}, not {changes}: "
+            "give these another --keep folder"
+        )
+    return d
 
 
 def _rotated(orientation, px: float, index: int):
@@ -96,6 +109,8 @@ def main(argv=None) -> int:
     ap.add_argument("--uniqueness", type=float, default=None, help="OsgmConfig.uniqueness (default its own)")
     ap.add_argument("--rotate-px", type=float, default=0.0,
                     help="turn every photo by a random rotation of so many px (sigma per axis)")  # fmt: skip
+    ap.add_argument("--scene", action="append", default=[], metavar="FIELD=VALUE",
+                    help="a SceneConfig field of every scene (optics_blur=2.0); its own --keep")  # fmt: skip
     ap.add_argument(
         "--set",
         action="append",
@@ -122,10 +137,21 @@ def main(argv=None) -> int:
             ap.error(f"--set {item!r}: {value!r} is not a Python literal")
     if not (args.rotate_px >= 0.0 and np.isfinite(args.rotate_px)):
         ap.error(f"--rotate-px: expected pixels >= 0, got {args.rotate_px}")
+    from truortho.core.synthetic import SceneConfig
+
+    scene_changes = {}
+    for item in args.scene:
+        name, sep, value = item.partition("=")
+        if not sep or name not in SceneConfig.__dataclass_fields__:
+            ap.error(f"--scene {item!r}: expected FIELD=VALUE with a SceneConfig field")
+        try:
+            scene_changes[name] = ast.literal_eval(value)
+        except (ValueError, SyntaxError):
+            ap.error(f"--scene {item!r}: {value!r} is not a Python literal")
     results = {}
     for i in indices:
         folder = os.path.join(args.keep, f"scene_{i:02d}")
-        d = _scene(i, args.seed, folder)
+        d = _scene(i, args.seed, folder, scene_changes)
         truth, _, _ = read_raster(os.path.join(folder, "dsm.tif"))
         out = OsgmOutputs(dsm=os.path.join(folder, f"osgm_{args.tag}.tif"),
                           confidence=os.path.join(folder, f"conf_{args.tag}.tif"))  # fmt: skip

@@ -6,7 +6,12 @@ release and floating-point flags are decided in one place:
 * ``cache=True`` with the cache in ``numba/`` of the per-user cache folder
   (:mod:`truortho.core.cache`: ``$TRUORTHO_CACHE_DIR``, else the OS cache
   folder), because the plugin folder may be read-only in a desktop install.
-  An explicit ``NUMBA_CACHE_DIR`` wins.
+  An explicit ``NUMBA_CACHE_DIR`` wins. numba checks a cached kernel against
+  its own file only: after editing a kernel that kernels of *other* files call
+  (``synthetic.texture._colour``, called by ``synthetic.render._trace``), touch
+  the callers' files or clear the cache, else they run the old code (seen while
+  adding the crop fields: identical figures before and after the edit). An
+  installed plugin never changes, so users are not affected.
 * ``nogil=True`` so tiles can run in threads.
 * ``fastmath`` only for :data:`fastjit` kernels whose results are compared
   statistically (matching costs); geometry kernels stay IEEE-exact so that

@@ -59,6 +59,15 @@ class SceneConfig:
     facade_windows : bool
         A repetitive grid of dark windows on every wall (storeys of 3 m, a
         window every 2.4 m).
+    crop_share : float
+        Share of the ground (in patches of about 25 m) that is fields of stalks: nearly uniform
+        soil under a layer of stalks ``crop_height`` above it, which each photo sees from its own
+        direction (a stubble or crop field; 0 = none). The truth DSM is the soil.
+    crop_height : float
+        Height of the stalk layer above the soil, metres.
+    optics_blur : float
+        Gaussian point spread of the optics, pixels (sigma; lens, focus, motion and demosaicing
+        together), applied before noise and JPEG; 0 = the sharp rendering.
 
     Ray casting
     -----------
@@ -159,6 +168,9 @@ class SceneConfig:
     texture_contrast: float = 2.6
     roof_contrast: tuple[float, float] = (1.0, 1.0)
     facade_windows: bool = False
+    crop_share: float = 0.0
+    crop_height: float = 0.3
+    optics_blur: float = 0.0
 
     fine_step: float = 0.03
     coarse_cell: float = 2.0
@@ -238,7 +250,8 @@ class SceneConfig:
                      "focal_px", "flying_height", "forward_overlap", "side_overlap", "heading_deg",
                      "attitude_sigma_deg", "position_sigma", "oblique_tilt_deg", "gain_sigma",
                      "offset_sigma", "vignetting", "noise_sigma", "check_fraction", "gcp_pixel_sigma",
-                     "gcp_clearance", "shadow_strength", "sun_azimuth_deg", "sun_elevation_deg"):
+                     "gcp_clearance", "shadow_strength", "sun_azimuth_deg", "sun_elevation_deg",
+                     "crop_share", "crop_height", "optics_blur"):
             finite(name, getattr(self, name))
         for name in ("terrain_relief", "building_gap", "grid_margin", "attitude_sigma_deg", "position_sigma",
                      "gain_sigma", "offset_sigma", "noise_sigma", "gcp_pixel_sigma", "gcp_clearance"):
@@ -257,7 +270,8 @@ class SceneConfig:
                              ("oblique_tilt_deg", 5.0, 70.0), ("vignetting", 0.0, 0.9),
                              ("check_fraction", 0.0, 1.0), ("tower_height", 1.0, 1e3),
                              ("tower_size", 2.0, 1e3), ("shadow_strength", 0.0, 0.9),
-                             ("sun_elevation_deg", 5.0, 90.0)):
+                             ("sun_elevation_deg", 5.0, 90.0), ("crop_share", 0.0, 1.0),
+                             ("crop_height", 0.0, 5.0), ("optics_blur", 0.0, 10.0)):
             if not lo <= getattr(self, name) <= hi:
                 bad(name, f"must lie in [{lo}, {hi}]")
         if self.coarse_cell < self.fine_step:

@@ -138,7 +138,9 @@ def _trace(xn, yn, R, C, terr, bld, g, cmax, cbld, pal, tex, sky, sun):
     x = C[0] + t * dx
     y = C[1] + t * dy
     z = C[2] + t * dz
-    col = _colour(x, y, z, m, b, pal, tex)
+    vx = dx / dz if dz < -1e-9 else 0.0
+    vy = dy / dz if dz < -1e-9 else 0.0
+    col = _colour(x, y, z, m, b, pal, tex, vx, vy)
     f = _sunlight(x, y, z, sun, terr, bld, g, cmax, cbld)
     return (col[0] * f, col[1] * f, col[2] * f), t, m, b, nrm
 

@@ -198,7 +198,8 @@ class SyntheticScene:
                                                 self.sun)
         if radiometry:
             idx = self.orientation.images.index(im)
-            return jpeg_roundtrip(apply_radiometry(colour, self.camera, self.radiometry[idx]),
+            blurred = optics_blur(colour, self.config.optics_blur)
+            return jpeg_roundtrip(apply_radiometry(blurred, self.camera, self.radiometry[idx]),
                                   self.config.jpeg_quality)
         return RenderResult(colour, depth, mat, bid, time.perf_counter() - t0)
 
@@ -286,6 +287,18 @@ def _write_geotiff(path: Path, bands: np.ndarray, gt, crs: str, nodata) -> None:
             tmp.unlink()
 
 
+def optics_blur(colour: np.ndarray, sigma: float) -> np.ndarray:
+    """``colour`` (H, W, 3) seen through optics whose point spread is a Gaussian of ``sigma`` pixels
+    (lens, focus, motion and demosaicing together; 0 = as rendered). Sky and surface alike."""
+    if sigma <= 0:
+        return colour
+    import cv2
+
+    out = cv2.GaussianBlur(np.ascontiguousarray(colour, np.float32), (0, 0), float(sigma),
+                           borderType=cv2.BORDER_REFLECT)  # fmt: skip
+    return out.astype(colour.dtype, copy=False)
+
+
 def make_scene(
     config: SceneConfig | None = None, progress: Progress | None = None, image_sink=None, skip_image=None
 ) -> SyntheticScene:
@@ -335,7 +348,7 @@ def make_scene(
     nb = len(surface.buildings)
     roof_contrast = np.random.default_rng([cfg.seed, 43]).uniform(*cfg.roof_contrast, nb)
     tex = texture_params(cfg.seed, cfg.texture_scale, cfg.texture_octaves, cfg.texture_contrast,
-                         cfg.facade_windows, roof_contrast)
+                         cfg.facade_windows, roof_contrast, cfg.crop_share, cfg.crop_height)
     sun = sun_vector(cfg.sun_azimuth_deg, cfg.sun_elevation_deg, cfg.shadow_strength)
     scene = SyntheticScene(cfg, surface, orientation, [], [], n_nadir, 0.0, palette(nb), tex, sun)
     rng = np.random.default_rng([cfg.seed, 41])
@@ -352,7 +365,8 @@ def make_scene(
             continue
         colour, _, _, _ = render_colour(surface, scene.palette, scene.tex, im.R, im.C, scene._subpixel(1),
                                         sub, cfg.adaptive_supersampling, sun)
-        rgb, jpeg = jpeg_file(apply_radiometry(colour, cam, rad), cfg.jpeg_quality)
+        seen = optics_blur(colour, cfg.optics_blur)
+        rgb, jpeg = jpeg_file(apply_radiometry(seen, cam, rad), cfg.jpeg_quality)
         if image_sink is None:
             scene.images.append(rgb)
             if jpeg is not None:

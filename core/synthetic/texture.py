@@ -59,15 +59,28 @@ def palette(n_buildings: int) -> np.ndarray:
 
 
 def texture_params(seed: int, scale: float, octaves: int, contrast: float, windows: bool = False,
-                   roof_contrast=()) -> np.ndarray:
+                   roof_contrast=(), crop_share: float = 0.0, crop_height: float = 0.0) -> np.ndarray:
     """Packed texture parameters for the kernels.
 
-    ``[seed, scale, octaves, contrast, windows, c_0, ..., c_{n-1}]``: ``windows`` (0/1) puts a
-    repetitive grid of dark windows on every wall; ``c_b`` scales the texture contrast of the
-    roof of building ``b`` (1 when absent: a contrast near 0 is a nearly uniform roof).
+    ``[seed, scale, octaves, contrast, windows, crop_share, crop_height, c_0, ..., c_{n-1}]``:
+    ``windows`` (0/1) puts a repetitive grid of dark windows on every wall; ``crop_share`` of the
+    ground is fields of stalks ``crop_height`` metres tall (see :func:`_colour`); ``c_b`` scales
+    the texture contrast of the roof of building ``b`` (1 when absent: a contrast near 0 is a
+    nearly uniform roof).
     """
     rc = [float(v) for v in roof_contrast]
-    return np.array([float(seed), float(scale), float(octaves), float(contrast), float(bool(windows))] + rc)
+    head = [float(seed), float(scale), float(octaves), float(contrast), float(bool(windows))]
+    return np.array(head + [float(crop_share), float(crop_height)] + rc)
+
+
+#: Index in :func:`texture_params` of the first roof's contrast factor.
+_ROOF0 = 7
+#: Side (metres) of the lattice of the noise that lays the fields out on the ground.
+CROP_PATCH = 25.0
+#: Heights at which :func:`_colour` looks for a stalk on a ray through a field's stalk layer.
+CROP_SLICES = 6
+#: Level of the stalk noise above which a point of the ground holds a stalk (about a fifth of it).
+_STALK_LEVEL = 0.62
 
 
 # ---------------------------------------------------------------- kernels
@@ -131,13 +144,52 @@ def _fbm(x, y, z, seed, scale, octaves):
 
 
 @njit
-def _colour(x, y, z, mat, b, pal, tex):
-    """RGB in [0, 1] of the surface point (x, y, z) of material ``mat`` (building ``b``)."""
+def _field(x, y, seed, share):
+    """Whether the ground point (x, y) lies in a field (``share`` of the ground, in patches)."""
+    if share <= 0.0:
+        return False
+    return _value_noise(x / CROP_PATCH, y / CROP_PATCH, 0.0, seed + 17) < share
+
+
+@njit
+def _straw(pal, shade):
+    """The second ground colour (straw, soil) at ``shade``."""
+    return min(pal[1, 0] * shade, 1.0), min(pal[1, 1] * shade, 1.0), min(pal[1, 2] * shade, 1.0)
+
+
+@njit
+def _colour(x, y, z, mat, b, pal, tex, vx=0.0, vy=0.0):
+    """RGB in [0, 1] of the surface point (x, y, z) of material ``mat`` (building ``b``), seen along
+    a ray that moves ``(vx, vy)`` horizontally per metre it rises towards the camera (0, 0 from
+    straight above).
+
+    In a field (:func:`_field`) the soil is nearly uniform and carries vertical stalks of up to
+    ``crop_height``: clumps a texture lattice spacing wide on about a fifth of the ground, each of
+    its own height. The ray is followed down through the stalk layer (:data:`CROP_SLICES` heights,
+    ``crop_height (vx, vy)`` of horizontal travel in all) and shows the first stalk it meets, darker
+    the lower it is hit, else the soil. A photo from straight above sees the stalks' tops, an
+    oblique one their sides at other heights and other places: as on a real stubble or crop field,
+    the photos do not see one surface.
+    """
     seed = np.int64(tex[0])
+    if mat == 0 and tex.shape[0] >= _ROOF0 and _field(x, y, seed, tex[5]):
+        h = tex[6]
+        s = tex[1]
+        for k in range(CROP_SLICES):
+            hk = h * (1.0 - (k + 0.5) / CROP_SLICES)
+            xt = x + hk * vx
+            yt = y + hk * vy
+            if _value_noise(xt / s, yt / s, 0.0, seed + 23) > _STALK_LEVEL:
+                top = h * _value_noise(xt / s, yt / s, 0.0, seed + 29)
+                if top >= hk:
+                    grain = _value_noise(xt / s, yt / s, 0.0, seed + 31)
+                    shade = (0.84 + 0.08 * hk / max(h, 1e-9)) * (0.97 + 0.06 * grain)
+                    return _straw(pal, shade)
+        return _straw(pal, 0.8 + 0.06 * _fbm(x, y, z, seed, s, np.int64(tex[2])))
     n = _fbm(x, y, z, seed + 37 * mat, tex[1], np.int64(tex[2]))
     contrast = tex[3]
-    if mat == 1 and tex.shape[0] > 5 + b:
-        contrast *= tex[5 + b]
+    if mat == 1 and tex.shape[0] > _ROOF0 + b:
+        contrast *= tex[_ROOF0 + b]
     v = 0.5 + contrast * (n - 0.5)
     v = min(max(v, 0.0), 1.0)
     shade = 0.45 + 0.9 * v

@@ -405,3 +405,57 @@ def test_apply_radiometry_equals_the_vectorised_formula(noise):
     plain = Radiometry(np.ones(3), np.zeros(3), 0.0, 0.0, 0)
     with pytest.raises(InputError, match="apply_radiometry"):
         apply_radiometry(np.zeros((4, 4)), flat, plain)
+
+
+def test_crop_fields_look_different_from_every_direction():
+    """In a field the ground's colour depends on the direction the photo looks from (the stalk layer
+    is crossed elsewhere by each ray); outside one, and with no fields at all, it does not."""
+    from truortho.core.synthetic.texture import _colour, _field, palette, texture_params
+
+    pal = palette(1)
+    seed = 3
+    fields = texture_params(seed, 0.15, 5, 2.6, crop_share=0.5, crop_height=0.3)
+    none = texture_params(seed, 0.15, 5, 2.6)
+    rng = np.random.default_rng(0)
+    pts = rng.uniform(0.0, 200.0, (400, 2))
+    inside = np.array([_field(x, y, seed, 0.5) for x, y in pts])
+    assert 0.2 < inside.mean() < 0.8  # about the share asked for, in patches
+    views = [(0.0, 0.0), (0.4, 0.1), (-0.3, 0.5)]  # horizontal travel per metre up: nadir, obliques
+
+    def colours(tex, x, y):
+        return np.array([_colour(x, y, 10.0, GROUND, -1, pal, tex, vx, vy) for vx, vy in views])
+
+    changed = [np.abs(colours(fields, x, y) - colours(fields, x, y)[0]).max() > 1e-3 for x, y in pts]
+    changed = np.array(changed)
+    assert changed[inside].mean() > 0.2  # some stalk or soil point differs from another view
+    assert not changed[~inside].any()
+    for x, y in pts[:50]:
+        c = colours(none, x, y)
+        assert np.array_equal(c, np.repeat(c[:1], len(views), axis=0))
+    # a field is nearly uniform straw: little contrast, whatever the view
+    field_rgb = np.array([colours(fields, x, y) for x, y in pts[inside]]).reshape(-1, 3)
+    assert field_rgb.std(axis=0).max() < 0.05
+    with pytest.raises(InputError, match="crop_share"):
+        SceneConfig(crop_share=1.5)
+    with pytest.raises(InputError, match="crop_height"):
+        SceneConfig(crop_height=-0.1)
+
+
+def test_optics_blur_softens_the_images_only():
+    """The optics' point spread removes fine detail from the photos and keeps their mean; the
+    geometry and the truth do not change."""
+    kw = dict(noise_sigma=0.0, vignetting=0.0, gain_sigma=0.0, offset_sigma=0.0, jpeg_quality=0)
+    sharp = make_scene(_small(**kw))
+    soft = make_scene(_small(optics_blur=1.5, **kw))
+    a = sharp.images[0].astype(float)
+    b = soft.images[0].astype(float)
+    assert abs(a.mean() - b.mean()) < 1.0
+    hf = [np.abs(np.diff(x, axis=1)).mean() for x in (a, b)]
+    assert hf[1] < 0.6 * hf[0]
+    assert np.array_equal(soft.render(0, radiometry=True), soft.images[0])
+    assert json.dumps(soft.orientation.to_dict()) == json.dumps(sharp.orientation.to_dict())
+    ta, _ = sharp.orthophoto(0.5, as_uint8=False)
+    tb, _ = soft.orthophoto(0.5, as_uint8=False)
+    assert np.array_equal(ta, tb)
+    with pytest.raises(InputError, match="optics_blur"):
+        SceneConfig(optics_blur=-1.0)
