@@ -94,9 +94,29 @@ GOALS = (
 # ------------------------------------------------------------------ scenes
 
 
-def draw_config(index: int, seed: int):
-    """The :class:`~truortho.core.synthetic.SceneConfig` of scene ``index`` (deterministic)."""
+#: Ranges of ``--realistic`` (:func:`draw_config`): the optics' point spread beyond the rendering's,
+#: px (real blocks measured 0 to about 1.4 px by ``bench/point_spread.py``), the share of the ground
+#: in crop fields and their stalks' height, metres.
+REALISTIC_BLUR = (0.0, 1.4)
+REALISTIC_CROPS = (0.0, 0.5)
+REALISTIC_STALKS = (0.1, 0.5)
+
+
+def draw_config(index: int, seed: int, realistic: bool = False):
+    """The :class:`~truortho.core.synthetic.SceneConfig` of scene ``index`` (deterministic).
+
+    ``realistic``: also an optics blur and crop fields (:data:`REALISTIC_BLUR` ...), drawn from a
+    stream of their own, so every other parameter of the scene is the same as without.
+    """
+    import dataclasses
+
     from truortho.core.synthetic import SceneConfig
+
+    if realistic:
+        more = np.random.default_rng([seed, index, 7]).uniform
+        blur, share, stalks = more(*REALISTIC_BLUR), more(*REALISTIC_CROPS), more(*REALISTIC_STALKS)
+        return dataclasses.replace(draw_config(index, seed), optics_blur=blur, crop_share=share,
+                                   crop_height=stalks)  # fmt: skip
 
     rng = np.random.default_rng([seed, index])
     u = rng.uniform
@@ -184,6 +204,8 @@ def describe(cfg) -> str:
         f"{' at ' + format(cfg.oblique_tilt_deg, '.0f') + ' deg' if cfg.n_oblique else ''}, JPEG q"
         f"{cfg.jpeg_quality}, shadows {cfg.shadow_strength:.2f}, "
         f"windows {'yes' if cfg.facade_windows else 'no'}"
+        + (f", blur {cfg.optics_blur:.2f} px" if cfg.optics_blur else "")
+        + (f", fields {100 * cfg.crop_share:.0f} % ({cfg.crop_height:.2f} m)" if cfg.crop_share else "")
     )
 
 
@@ -331,7 +353,7 @@ def ortho_figures(path: str, truth_rgb, buildings, seen, unseen_core, gsd: float
 # ------------------------------------------------------------------ one scene
 
 
-def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
+def run_scene(index: int, seed: int, work: str, sgbm: bool, log, realistic: bool = False) -> dict:
     from scipy.ndimage import binary_erosion
 
     from truortho.core.ortho import evaluate as ev
@@ -342,7 +364,7 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log) -> dict:
     from truortho.core.surface.quality import streak_index
     from truortho.core.synthetic import make_scene
 
-    cfg = draw_config(index, seed)
+    cfg = draw_config(index, seed, realistic)
     log(f"scene {index}: {describe(cfg)}")
     t = time.perf_counter()
     scene = make_scene(cfg)
@@ -727,8 +749,10 @@ def warm_up(work: str, log) -> None:
 SEED = 2026
 
 
-def docs_section(seed: int) -> str:
-    """The docs section a run of master seed ``seed`` writes."""
+def docs_section(seed: int, realistic: bool = False) -> str:
+    """The docs section a run of master seed ``seed`` (with ``--realistic``) writes."""
+    if realistic:
+        return f"acceptance-seed{seed}-realistic"
     return "acceptance" if seed == SEED else f"acceptance-seed{seed}"
 
 
@@ -739,6 +763,8 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=SEED, help=seed_help)
     ap.add_argument("--only", default="", help="comma-separated scene indices (default all)")
     ap.add_argument("--no-sgbm", action="store_true", help="skip the pairwise SGBM baseline")
+    ap.add_argument("--realistic", action="store_true",
+                    help="also draw an optics blur and crop fields per scene (own docs section)")  # fmt: skip
     ap.add_argument("--keep", default="", help="keep the scenes and products in this folder")
     ap.add_argument("--write-docs", action="store_true", help=f"update the marked section of {DOCS}")
     ap.add_argument("--report", default="", help="print (and with --write-docs write) the tables of a saved "
@@ -750,7 +776,8 @@ def main(argv=None) -> int:
         text = "\n".join([saved["head"], "", *summary(saved["rows"]), "", *scene_table(saved["rows"]), ""])
         print(text)
         if args.write_docs:
-            write_docs(text, docs_section(int(saved.get("seed", SEED))))
+            section = docs_section(int(saved.get("seed", SEED)), bool(saved.get("realistic", False)))
+            write_docs(text, section)
         return 0
     indices = [int(v) for v in args.only.split(",") if v] or list(range(args.scenes))
     work = args.keep or tempfile.mkdtemp(prefix="truortho-acceptance-")
@@ -768,7 +795,7 @@ def main(argv=None) -> int:
     try:
         warm_up(work, log)
         for i in indices:
-            rows.append(run_scene(i, args.seed, work, not args.no_sgbm, log))
+            rows.append(run_scene(i, args.seed, work, not args.no_sgbm, log, args.realistic))
     finally:
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
@@ -776,17 +803,19 @@ def main(argv=None) -> int:
     import cv2
 
     cmd, commit, head = run_header("acceptance.py", argv, f"OpenCV {cv2.__version__}", started)
-    head += f"; {len(rows)} scenes, master seed {args.seed}, {wall / 60:.1f} min"
+    kind = " (realistic)" if args.realistic else ""
+    head += f"; {len(rows)} scenes, master seed {args.seed}{kind}, {wall / 60:.1f} min"
     text = "\n".join([head, "", *summary(rows), "", *scene_table(rows), ""])
     print("\n" + text)
     os.makedirs(os.path.join(HERE, "results"), exist_ok=True)
     name = "acceptance_only.json" if args.only else "acceptance.json"
     with open(os.path.join(HERE, "results", name), "w") as fh:
         json.dump(
-            {"command": cmd, "commit": commit, "seed": args.seed, "head": head, "rows": rows}, fh, indent=1
+            {"command": cmd, "commit": commit, "seed": args.seed, "realistic": args.realistic, "head": head,
+             "rows": rows}, fh, indent=1  # fmt: skip
         )
     if args.write_docs:
-        write_docs(text, docs_section(args.seed))
+        write_docs(text, docs_section(args.seed, args.realistic))
     return 0
 
 
