@@ -4,7 +4,7 @@ Not a test. For scenes that ``bench/acceptance.py --seed N --keep DIR`` kept (th
 ``dsm.tif`` and ``osgm.tif``), run from the repository root::
 
     source scripts/env.sh && python -P bench/ortho_rerun.py DIR --seed N [--only 0,4] \\
-        [--set noise_tolerance=4 --set consistency=0] [--surfaces dsm.tif,osgm.tif]
+        [--set noise_tolerance=4 --set consistency=0] [--surfaces dsm.tif,osgm.tif] [--realistic]
 
 For every scene and surface it runs ``true_ortho`` once with the defaults and once with the
 ``--set`` changes (fields of ``TrueOrthoConfig``; without ``--set`` only the defaults), into a
@@ -70,6 +70,7 @@ def main(argv=None) -> int:
     ap.add_argument("--only", default="", help="comma-separated scene indices (default every kept one)")
     ap.add_argument("--set", action="append", default=[], help="FIELD=VALUE of TrueOrthoConfig")
     ap.add_argument("--surfaces", default="dsm.tif,osgm.tif", help="comma-separated surfaces of a scene")
+    ap.add_argument("--realistic", action="store_true", help="scenes kept by acceptance.py --realistic")
     args = ap.parse_args(argv)
 
     import acceptance as acc
@@ -98,7 +99,7 @@ def main(argv=None) -> int:
             for name in ["dsm.tif", "orientation.json"] + surfaces:
                 if not os.path.isfile(os.path.join(folder, name)):
                     raise SystemExit(f"{folder}: {name} not found (acceptance.py --keep keeps it)")
-            cfg = acc.draw_config(index, args.seed)
+            cfg = acc.draw_config(index, args.seed, args.realistic)
             scene = make_scene(cfg)
             truth, grid, _ = read_raster(os.path.join(folder, "dsm.tif"))
             res = grid.res
