@@ -126,28 +126,26 @@ def main(argv=None) -> int:
     from truortho.core.rasterio_io import read_raster
 
     indices = [int(v) for v in args.only.split(",") if v] or list(range(12))
-    extra = {} if args.uniqueness is None else {"uniqueness": args.uniqueness}
-    for item in args.set:
-        name, sep, value = item.partition("=")
-        if not sep or name not in OsgmConfig.__dataclass_fields__:
-            ap.error(f"--set {item!r}: expected FIELD=VALUE with an OsgmConfig field")
-        try:
-            extra[name] = ast.literal_eval(value)
-        except (ValueError, SyntaxError):
-            ap.error(f"--set {item!r}: {value!r} is not a Python literal")
-    if not (args.rotate_px >= 0.0 and np.isfinite(args.rotate_px)):
-        ap.error(f"--rotate-px: expected pixels >= 0, got {args.rotate_px}")
     from truortho.core.synthetic import SceneConfig
 
-    scene_changes = {}
-    for item in args.scene:
-        name, sep, value = item.partition("=")
-        if not sep or name not in SceneConfig.__dataclass_fields__:
-            ap.error(f"--scene {item!r}: expected FIELD=VALUE with a SceneConfig field")
-        try:
-            scene_changes[name] = ast.literal_eval(value)
-        except (ValueError, SyntaxError):
-            ap.error(f"--scene {item!r}: {value!r} is not a Python literal")
+    def fields(option: str, items: list[str], cls) -> dict:
+        """``FIELD=VALUE`` items (Python literals) of the dataclass ``cls``."""
+        out = {}
+        for item in items:
+            name, sep, value = item.partition("=")
+            if not sep or name not in cls.__dataclass_fields__:
+                ap.error(f"{option} {item!r}: expected FIELD=VALUE with a {cls.__name__} field")
+            try:
+                out[name] = ast.literal_eval(value)
+            except (ValueError, SyntaxError):
+                ap.error(f"{option} {item!r}: {value!r} is not a Python literal")
+        return out
+
+    extra = {} if args.uniqueness is None else {"uniqueness": args.uniqueness}
+    extra.update(fields("--set", args.set, OsgmConfig))
+    scene_changes = fields("--scene", args.scene, SceneConfig)
+    if not (args.rotate_px >= 0.0 and np.isfinite(args.rotate_px)):
+        ap.error(f"--rotate-px: expected pixels >= 0, got {args.rotate_px}")
     results = {}
     for i in indices:
         folder = os.path.join(args.keep, f"scene_{i:02d}")
