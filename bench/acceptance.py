@@ -231,22 +231,6 @@ def dsm_masks(truth: np.ndarray, gsd: float, res: float) -> np.ndarray:
     return _maxf(step.astype(np.uint8), 2 * r + 1).astype(bool)
 
 
-def stalk_heights(scene, cfg, grid) -> np.ndarray:
-    """(rows, cols) height of the crop fields' stalk layer over the soil at the cells of ``grid``
-    (``SceneConfig.crop_height`` in a field, 0 elsewhere and without fields)."""
-    rows, cols = grid.rows, grid.cols
-    if not cfg.crop_share > 0 or not cfg.crop_height > 0:
-        return np.zeros((rows, cols))
-    from truortho.core.synthetic.texture import _field
-    from truortho.core.synthetic.truth import grid_centres
-
-    xy, shape, _ = grid_centres(grid.res, scene.extent_world(), np.asarray(cfg.offset, float))
-    _, bid = scene.surface.height(xy)
-    seed = np.int64(cfg.seed)
-    inside = np.array([_field(x, y, seed, cfg.crop_share) for x, y in xy]) & (bid < 0)
-    return np.where(inside, cfg.crop_height, 0.0).reshape(shape)
-
-
 def within_stalks(dsm: np.ndarray, truth: np.ndarray, stalks: np.ndarray) -> np.ndarray:
     """The truth a DSM is measured against: in a crop field any height from the soil to the stalks'
     tops is right (a DSM of a field lies in its stalk layer), so the truth there is the DSM's height
@@ -428,7 +412,7 @@ def run_scene(index: int, seed: int, work: str, sgbm: bool, log, realistic: bool
              folder)  # fmt: skip
     t_osgm = time.perf_counter() - t
     dsm, _, _ = read_raster(out.dsm)
-    stalks = stalk_heights(scene, cfg, grid)
+    stalks = scene.crop_heights(res)
     row["fields"] = float((stalks > 0).mean())
     # in crop fields any height in the stalk layer is right (without fields: the truth itself)
     ref = within_stalks(dsm, truth, stalks)

@@ -60,7 +60,6 @@ def main(argv=None) -> int:
     from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
     from truortho.core.rasterio_io import read_raster
     from truortho.core.synthetic import make_scene
-    from truortho.core.synthetic.texture import _field
     from truortho.core.synthetic.truth import grid_centres
 
     work = args.keep or tempfile.mkdtemp(prefix="truortho-crop-")
@@ -80,9 +79,9 @@ def main(argv=None) -> int:
             xy, shape, _ = grid_centres(res, scene.extent_world(), np.asarray(cfg.offset, float))
             _, bid = scene.surface.height(xy)
             ground = (bid < 0).reshape(shape)
-            inside = np.array([_field(x, y, np.int64(cfg.seed), args.share) for x, y in xy]).reshape(shape)
+            inside = scene.crop_heights(res) > 0
             edge = acc.dsm_masks(truth, gsd, res)
-            masks = (("fields", binary_erosion(inside & ground, iterations=5) & ~edge),
+            masks = (("fields", binary_erosion(inside, iterations=5) & ~edge),
                      ("other ground", ~inside & ground & ~edge))  # fmt: skip
             zlo, zhi = float(np.nanmin(truth)) - 5.0, float(np.nanmax(truth)) + 5.0
             out = OsgmOutputs(dsm=os.path.join(folder, "osgm.tif"))

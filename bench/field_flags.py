@@ -6,14 +6,15 @@ Not a test. For a window of the products that ``bench/real_blocks.py --keep DIR`
 ``orientation.json`` and ``dsm.tif``), run from the repository root::
 
     source scripts/env.sh && python -P bench/field_flags.py DIR/boruszyn/products \\
-        --rows 150:400 --cols 350:600 [--margin 50] [--floor 0,0.02]
+        --rows 150:400 --cols 350:600 [--margin 50] [--floor 0,0.02] [--set radius=3 ...]
 
 For every ``--floor`` (0: OSGM as it is; else every tile's saturation scale, the median
 |gradient| of ``sweep.gradient_scales``, is raised to at least that share of the photos' full
 scale) it runs ``run_osgm`` on the window grown by ``--margin`` cells (the products' resolution,
 Z range from their DSM there, -5/+10 m), and prints for the window: the departures of the raw DSM
 from its 9 x 9 median (5 and 95 %, and 1.4826 x their median absolute value), its holes, and the
-share of the window's cells that ``true_ortho`` on that DSM flags as seen by no photo. The figures
+share of the window's cells that ``true_ortho`` on that DSM flags as seen by no photo. ``--set
+FIELD=VALUE`` changes an ``OsgmConfig`` field (``radius=3``, ``measure='census'``). The figures
 of boruszyn's harvested field in docs/acceptance.md (*Real photo blocks*) were measured this way.
 """
 
@@ -45,6 +46,8 @@ def main(argv=None) -> int:
     ap.add_argument("--cols", required=True, help="FIRST:STOP columns of the products' DSM")
     ap.add_argument("--margin", type=int, default=50, help="cells of OSGM's extent around the window")
     ap.add_argument("--floor", default="0", help="comma-separated floors of the saturation scale (0: none)")
+    ap.add_argument("--set", action="append", default=[], metavar="FIELD=VALUE",
+                    help="an OsgmConfig field, as a Python literal (radius=3); repeatable")  # fmt: skip
     args = ap.parse_args(argv)
     (r0, r1), (c0, c1) = _span(args.rows, "rows"), _span(args.cols, "cols")
     if args.margin < 0:
@@ -61,12 +64,16 @@ def main(argv=None) -> int:
 
     from scipy.ndimage import median_filter
 
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from osgm_battery import dataclass_fields
+
     import truortho.core.osgm.sweep as sweep
     from truortho.core.orientation import Orientation
     from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho
     from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
     from truortho.core.rasterio_io import read_raster
 
+    changes = dataclass_fields(ap, "--set", args.set, OsgmConfig)
     o = Orientation.load(os.path.join(args.products, "orientation.json"))
     dsm, grid, _ = read_raster(os.path.join(args.products, "dsm.tif"))
     if r1 > grid.rows or c1 > grid.cols:
@@ -92,7 +99,8 @@ def main(argv=None) -> int:
         try:
             path = os.path.join(out_dir, f"osgm_{floor:g}.tif")
             t = time.perf_counter()
-            run_osgm(o, OsgmConfig(resolution=res, z_min=zlo, z_max=zhi), extent, OsgmOutputs(dsm=path))
+            ocfg = OsgmConfig(resolution=res, z_min=zlo, z_max=zhi, **changes)
+            run_osgm(o, ocfg, extent, OsgmOutputs(dsm=path))
             seconds = time.perf_counter() - t
         finally:
             sweep.gradient_scales = own

@@ -74,6 +74,21 @@ def _scene(i: int, seed: int, folder: str, changes: dict | None = None) -> dict:
     return d
 
 
+def dataclass_fields(ap: argparse.ArgumentParser, option: str, items: list[str], cls) -> dict:
+    """``FIELD=VALUE`` items of ``option`` (values as Python literals) naming fields of the dataclass
+    ``cls``; anything else stops ``ap`` with a message naming the item."""
+    out = {}
+    for item in items:
+        name, sep, value = item.partition("=")
+        if not sep or name not in cls.__dataclass_fields__:
+            ap.error(f"{option} {item!r}: expected FIELD=VALUE with a {cls.__name__} field")
+        try:
+            out[name] = ast.literal_eval(value)
+        except (ValueError, SyntaxError):
+            ap.error(f"{option} {item!r}: {value!r} is not a Python literal")
+    return out
+
+
 def _rotated(orientation, px: float, index: int):
     """A copy of ``orientation`` with every photo turned by a random rotation of ``px`` pixels."""
     import copy
@@ -128,22 +143,9 @@ def main(argv=None) -> int:
     indices = [int(v) for v in args.only.split(",") if v] or list(range(12))
     from truortho.core.synthetic import SceneConfig
 
-    def fields(option: str, items: list[str], cls) -> dict:
-        """``FIELD=VALUE`` items (Python literals) of the dataclass ``cls``."""
-        out = {}
-        for item in items:
-            name, sep, value = item.partition("=")
-            if not sep or name not in cls.__dataclass_fields__:
-                ap.error(f"{option} {item!r}: expected FIELD=VALUE with a {cls.__name__} field")
-            try:
-                out[name] = ast.literal_eval(value)
-            except (ValueError, SyntaxError):
-                ap.error(f"{option} {item!r}: {value!r} is not a Python literal")
-        return out
-
     extra = {} if args.uniqueness is None else {"uniqueness": args.uniqueness}
-    extra.update(fields("--set", args.set, OsgmConfig))
-    scene_changes = fields("--scene", args.scene, SceneConfig)
+    extra.update(dataclass_fields(ap, "--set", args.set, OsgmConfig))
+    scene_changes = dataclass_fields(ap, "--scene", args.scene, SceneConfig)
     if not (args.rotate_px >= 0.0 and np.isfinite(args.rotate_px)):
         ap.error(f"--rotate-px: expected pixels >= 0, got {args.rotate_px}")
     results = {}

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import os
 import time
 from dataclasses import dataclass, field
@@ -38,7 +39,7 @@ from .render import (
     sun_vector,
 )
 from .surface import Surface
-from .texture import _colour_many, palette, texture_params
+from .texture import _colour_many, field_mask, palette, texture_params
 
 
 @dataclass
@@ -153,6 +154,18 @@ class SyntheticScene:
         rgb, gt = truth.orthophoto(self.surface, self.palette, self.tex, resolution,
                                    extent or self.extent_world(), self.offset, self.sun)
         return (np.clip(np.round(rgb * 255), 0, 255).astype(np.uint8) if as_uint8 else rgb), gt
+
+    def crop_heights(self, resolution: float, extent=None) -> np.ndarray:
+        """(rows, cols) height of the crop fields' stalk layer above the soil at the cell centres of
+        the grid of :meth:`orthophoto` (``config.crop_height`` in a field, 0 elsewhere, on roofs
+        and without fields)."""
+        xy, shape, _ = truth.grid_centres(resolution, extent or self.extent_world(), self.offset)
+        cfg = self.config
+        if not (cfg.crop_share > 0 and cfg.crop_height > 0):
+            return np.zeros(shape)
+        _, bid = self.surface.height(xy)
+        inside = field_mask(xy, cfg.seed, cfg.crop_share) & (bid < 0)
+        return np.where(inside, cfg.crop_height, 0.0).reshape(shape)
 
     def visibility(self, points_world, image: int | str, tol: float = 0.01, check_frame: bool = True):
         """``(visible (N,) bool, uv (N, 2), hit_distance (N,))`` of world points in one image.
@@ -290,7 +303,12 @@ def _write_geotiff(path: Path, bands: np.ndarray, gt, crs: str, nodata) -> None:
 def optics_blur(colour: np.ndarray, sigma: float) -> np.ndarray:
     """``colour`` (H, W, 3) seen through optics whose point spread is a Gaussian of ``sigma`` pixels
     (lens, focus, motion and demosaicing together; 0 = as rendered). Sky and surface alike."""
-    if sigma <= 0:
+    c = np.asarray(colour)
+    if c.ndim != 3 or c.shape[2] != 3:
+        raise InputError(f"optics_blur: expected (H, W, 3) colours, got shape {c.shape}")
+    if not (math.isfinite(float(sigma)) and sigma >= 0):
+        raise InputError(f"optics_blur: sigma must be a finite number of pixels >= 0, got {sigma!r}")
+    if sigma == 0:
         return colour
     import cv2
 

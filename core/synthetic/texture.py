@@ -151,6 +151,27 @@ def _field(x, y, seed, share):
     return _value_noise(x / CROP_PATCH, y / CROP_PATCH, 0.0, seed + 17) < share
 
 
+@pjit
+def _field_many(xy, seed, share, out):
+    for i in prange(xy.shape[0]):
+        out[i] = _field(xy[i, 0], xy[i, 1], seed, share)
+
+
+def field_mask(xy, seed: int, share: float) -> np.ndarray:
+    """(N,) bool: which local ground points ``xy`` (N, 2) lie in a crop field (:func:`_field`) of a
+    scene with texture seed ``seed`` and ``crop_share`` ``share``."""
+    from ..errors import InputError
+
+    p = np.ascontiguousarray(xy, dtype=np.float64)
+    if p.ndim != 2 or p.shape[1] != 2:
+        raise InputError(f"field_mask: expected (N, 2) points, got shape {p.shape}")
+    if not (0.0 <= float(share) <= 1.0):
+        raise InputError(f"field_mask: share must lie in [0, 1], got {share!r}")
+    out = np.zeros(len(p), np.bool_)
+    _field_many(p, np.int64(seed), float(share), out)
+    return out
+
+
 @njit
 def _straw(pal, shade):
     """The second ground colour (straw, soil) at ``shade``."""

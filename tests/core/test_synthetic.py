@@ -459,3 +459,26 @@ def test_optics_blur_softens_the_images_only():
     assert np.array_equal(ta, tb)
     with pytest.raises(InputError, match="optics_blur"):
         SceneConfig(optics_blur=-1.0)
+
+
+def test_crop_heights_and_their_inputs():
+    """The stalk layer's height per cell: crop_height in the fields, 0 on roofs, elsewhere and in a
+    scene without fields; bad inputs of the helpers say what was expected."""
+    from truortho.core.synthetic.scene import optics_blur
+    from truortho.core.synthetic.texture import field_mask
+
+    kw = dict(noise_sigma=0.0, jpeg_quality=0)
+    crops = make_scene(_small(crop_share=0.5, crop_height=0.4, **kw))
+    h = crops.crop_heights(0.5)
+    rgb, _ = crops.orthophoto(0.5)
+    assert h.shape == rgb.shape[:2]
+    assert set(np.unique(h)) <= {0.0, 0.4} and 0.1 < (h > 0).mean() < 0.9
+    assert not make_scene(_small(**kw)).crop_heights(0.5).any()
+    with pytest.raises(InputError, match="field_mask"):
+        field_mask(np.zeros((3, 3)), 1, 0.5)
+    with pytest.raises(InputError, match="share"):
+        field_mask(np.zeros((3, 2)), 1, 1.5)
+    with pytest.raises(InputError, match="sigma"):
+        optics_blur(np.zeros((4, 4, 3)), float("nan"))
+    with pytest.raises(InputError, match="colours"):
+        optics_blur(np.zeros((4, 4)), 1.0)
