@@ -8,7 +8,8 @@ rendered once into ``--keep DIR`` (with the truth masks the figures need); later
         [--z-step-factor 1.5] [--uniqueness 0.99] [--set refine_edges=False ...]
 
 Prints, per scene, the OSGM wall time and the figures of ``acceptance.dsm_figures`` (completeness,
-NMAD in GSD, flat3, edge3) and the DSM's roughness (1.4826 x the median departure from its 9 x 9
+NMAD in GSD, flat3, edge3), what the failed edge cells are (``acceptance.edge_failures``) and the
+DSM's roughness (1.4826 x the median departure from its 9 x 9
 median surface away from edges, in GSD: noise, where NMAD also counts offsets), writes them to
 ``DIR/<tag>.json`` and each DSM to ``DIR/scene_NN/osgm_<tag>.tif``, so that two variants of the
 code can be compared cell by cell.
@@ -19,7 +20,8 @@ loop (scenes 1-11 for times: the first scene also loads the compiled kernels).
 per axis, at the photo's focal length; drawn per scene, the same on every run): cameras as a
 bundle adjustment leaves them instead of the exact ones. ``--scene FIELD=VALUE`` renders every
 scene with a ``SceneConfig`` field changed (``optics_blur=2.0``, ``crop_share=0.5``), into its own
-``--keep`` folder.
+``--keep`` folder. ``--realistic`` draws the scenes of ``acceptance.py --realistic`` (optics blur,
+crop fields; the DSM figures in a field against the interval from the soil to the stalks' tops).
 """
 
 from __future__ import annotations
@@ -37,9 +39,10 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def _scene(i: int, seed: int, folder: str, changes: dict | None = None) -> dict:
-    """The cached scene ``i`` (rendered and pickled on first use), with ``changes`` to its
-    ``SceneConfig`` (a folder holds the scene of one set of changes only)."""
+def _scene(i: int, seed: int, folder: str, changes: dict | None = None, realistic: bool = False) -> dict:
+    """The cached scene ``i`` (rendered and pickled on first use), drawn as ``acceptance.py
+    [--realistic]`` draws it, with ``changes`` to its ``SceneConfig`` (a folder holds the scene of
+    one draw and one set of changes only)."""
     import dataclasses
 
     from acceptance import draw_config, dsm_masks
@@ -52,7 +55,7 @@ def _scene(i: int, seed: int, folder: str, changes: dict | None = None) -> dict:
         from truortho.core.ortho import evaluate as ev
         from truortho.core.synthetic import make_scene
 
-        cfg = dataclasses.replace(draw_config(i, seed), **changes)
+        cfg = dataclasses.replace(draw_config(i, seed, realistic), **changes)
         scene = make_scene(cfg)
         scene.write(folder)
         truth, grid, _ = read_raster(os.path.join(folder, "dsm.tif"))
@@ -60,7 +63,7 @@ def _scene(i: int, seed: int, folder: str, changes: dict | None = None) -> dict:
             "o": scene.orientation, "res": grid.res, "ext": scene.extent_world(), "gsd": cfg.gsd,
             "zlo": float(np.nanmin(truth)) - 5.0, "zhi": float(np.nanmax(truth)) + 5.0,
             "nvis": ev.truth_view_counts(scene, grid, tol=0.05), "edge": dsm_masks(truth, cfg.gsd, grid.res),
-            "scene_changes": changes,
+            "scene_changes": changes, "realistic": realistic, "stalks": scene.crop_heights(grid.res),
         }  # fmt: skip
         with open(path, "wb") as fh:
             pickle.dump(d, fh)
@@ -70,6 +73,11 @@ def _scene(i: int, seed: int, folder: str, changes: dict | None = None) -> dict:
         raise SystemExit(
             f"{folder}: rendered with the scene changes {d.get('scene_changes', {})}, not {changes}: "
             "give these another --keep folder"
+        )
+    if d.get("realistic", False) != realistic:
+        raise SystemExit(
+            f"{folder}: rendered {'with' if d.get('realistic') else 'without'} --realistic: "
+            "give this run another --keep folder"
         )
     return d
 
@@ -124,6 +132,8 @@ def main(argv=None) -> int:
     ap.add_argument("--uniqueness", type=float, default=None, help="OsgmConfig.uniqueness (default its own)")
     ap.add_argument("--rotate-px", type=float, default=0.0,
                     help="turn every photo by a random rotation of so many px (sigma per axis)")  # fmt: skip
+    ap.add_argument("--realistic", action="store_true",
+                    help="the scenes of acceptance.py --realistic (optics blur, crop fields)")  # fmt: skip
     ap.add_argument("--scene", action="append", default=[], metavar="FIELD=VALUE",
                     help="a SceneConfig field of every scene (optics_blur=2.0); its own --keep")  # fmt: skip
     ap.add_argument(
@@ -135,7 +145,7 @@ def main(argv=None) -> int:
     )
     args = ap.parse_args(argv)
     sys.path.insert(0, HERE)
-    from acceptance import dsm_figures
+    from acceptance import dsm_figures, edge_failures, within_stalks
 
     from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
     from truortho.core.rasterio_io import read_raster
@@ -151,7 +161,7 @@ def main(argv=None) -> int:
     results = {}
     for i in indices:
         folder = os.path.join(args.keep, f"scene_{i:02d}")
-        d = _scene(i, args.seed, folder, scene_changes)
+        d = _scene(i, args.seed, folder, scene_changes, args.realistic)
         truth, _, _ = read_raster(os.path.join(folder, "dsm.tif"))
         out = OsgmOutputs(dsm=os.path.join(folder, f"osgm_{args.tag}.tif"),
                           confidence=os.path.join(folder, f"conf_{args.tag}.tif"))  # fmt: skip
@@ -162,12 +172,28 @@ def main(argv=None) -> int:
         run_osgm(o, cfg, d["ext"], out, folder)
         seconds = time.perf_counter() - t
         dsm, _, _ = read_raster(out.dsm)
-        f = dict(dsm_figures(dsm, truth, d["nvis"] >= 2, d["edge"], d["gsd"]), seconds=seconds)
+        # in crop fields any height in the stalk layer is right (as acceptance.py measures it)
+        stalks = d.get("stalks", np.zeros_like(truth))
+        ref = within_stalks(dsm, truth, stalks)
+        f = dict(dsm_figures(dsm, ref, d["nvis"] >= 2, d["edge"], d["gsd"]), seconds=seconds)
         f["roughness_gsd"] = _roughness(dsm, d["edge"]) / d["gsd"]
+        # what the edge cells off by more than 3 GSD are (shares of the edge cells)
+        f.update(edge_failures(dsm, ref, d["nvis"] >= 2, d["edge"], d["gsd"], d["res"]))
+        fields = ""
+        if (stalks > 0).any():
+            # the same figures inside and outside the crop fields
+            for name, m in (("fields", stalks > 0), ("other", stalks <= 0)):
+                g = dsm_figures(dsm, ref, (d["nvis"] >= 2) & m, d["edge"], d["gsd"])
+                f.update({f"{k}_{name}": g[k] for k in ("nmad_gsd", "flat3", "edge3")})
+            # (no NMAD in the fields: any height in the stalk layer reads an error of 0 there)
+            fields = (f"; fields {float((stalks > 0).mean()):.0%}: flat3 {f['flat3_fields']:.4f} edge3 "
+                      f"{f['edge3_fields']:.4f}, elsewhere nmad {f['nmad_gsd_other']:.3f} flat3 "
+                      f"{f['flat3_other']:.4f} edge3 {f['edge3_other']:.4f}")
         results[str(i)] = f
         print(f"{args.tag} scene {i}: {seconds:6.1f} s, completeness {f['completeness']:.4f}, "
               f"nmad {f['nmad_gsd']:.3f} GSD, flat3 {f['flat3']:.4f}, edge3 {f['edge3']:.4f}, "
-              f"roughness {f['roughness_gsd']:.3f} GSD",
+              f"roughness {f['roughness_gsd']:.3f} GSD, edge cells fattened {f['edge_fattened']:.3f} eroded "
+              f"{f['edge_eroded']:.3f} own side {f['edge_own_side']:.3f}{fields}",
               flush=True)  # fmt: skip
     with open(os.path.join(args.keep, f"{args.tag}.json"), "w") as fh:
         json.dump(results, fh, indent=1)
