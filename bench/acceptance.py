@@ -100,13 +100,17 @@ GOALS = (
 REALISTIC_BLUR = (0.0, 1.4)
 REALISTIC_CROPS = (0.0, 0.5)
 REALISTIC_STALKS = (0.1, 0.5)
+#: JPEG quality of ``--realistic`` (IJG scale): the real blocks' luminance tables read 90 to 100
+#: (``bench/point_spread.py``), where the battery's own draw spans 70 to 95.
+REALISTIC_JPEG = (90, 100)
 
 
 def draw_config(index: int, seed: int, realistic: bool = False):
     """The :class:`~truortho.core.synthetic.SceneConfig` of scene ``index`` (deterministic).
 
-    ``realistic``: also an optics blur and crop fields (:data:`REALISTIC_BLUR` ...), drawn from a
-    stream of their own, so every other parameter of the scene is the same as without.
+    ``realistic``: also an optics blur, crop fields and the JPEG quality of the real blocks
+    (:data:`REALISTIC_BLUR` ...), drawn from a stream of their own, so every other parameter of the
+    scene is the same as without.
     """
     import dataclasses
 
@@ -115,8 +119,9 @@ def draw_config(index: int, seed: int, realistic: bool = False):
     if realistic:
         more = np.random.default_rng([seed, index, 7]).uniform
         blur, share, stalks = more(*REALISTIC_BLUR), more(*REALISTIC_CROPS), more(*REALISTIC_STALKS)
+        quality = int(round(more(*REALISTIC_JPEG)))
         return dataclasses.replace(draw_config(index, seed), optics_blur=blur, crop_share=share,
-                                   crop_height=stalks)  # fmt: skip
+                                   crop_height=stalks, jpeg_quality=quality)  # fmt: skip
 
     rng = np.random.default_rng([seed, index])
     u = rng.uniform
