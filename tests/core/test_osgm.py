@@ -603,6 +603,39 @@ def test_edge_decision_takes_wall_heights_and_holes_outright():
     assert not fill[2] and not switch[2]
 
 
+def test_edge_switch_needs_evidence():
+    """A cell leaves its side (core/osgm/edges.py, WEAK_PAIRS) unless its own side is judged on a
+    single pair of views and the other side's match is one of flat patches (they vary less within
+    themselves than between the views: a uniform field agrees at roof height as well)."""
+    from truortho.core.osgm.edges import RATIO, WEAK_PAIRS, _decide, _spread
+
+    step = 1.0
+    zc = np.full(4, 0.1)
+    lo, hi = np.zeros(4), np.full(4, 10.0)
+    cost = np.stack([np.ones(4), np.full(4, 0.5 * RATIO)])  # the high side clearly better
+    npairs = np.array([[1, 1, WEAK_PAIRS, WEAK_PAIRS], [3, 3, 3, 3]])
+    spread = np.stack([np.ones(4), np.array([0.1, 0.9, 0.1, 0.9])])
+    _, switch, _ = _decide(zc, np.stack([lo, hi]), (lo + hi) / 2, cost, npairs, step, None, spread)
+    # 0: one pair against flat patches -> stays; 1: textured patches -> switches; 2, 3: enough pairs
+    assert switch.tolist() == [False, True, True, True]
+    # without spreads every match counts as one of texture
+    _, switch, _ = _decide(zc, np.stack([lo, hi]), (lo + hi) / 2, cost, npairs, step)
+    assert switch.all()
+    # the spread: per view the patch's standard deviation, averaged over the views that see it
+    rng = np.random.default_rng(3)
+    samples = rng.normal(0.0, 1.0, (3, 5, 9)).astype(np.float32)
+    samples[1, 0] *= 0.0
+    samples[2, 1, 4] = np.nan  # a view with a missing sample does not count
+    visible = np.ones((3, 5), bool)
+    visible[:, 4] = False
+    got = _spread(samples, visible)
+    sd = samples.std(axis=2)
+    assert np.isclose(got[0], (sd[0, 0] + sd[2, 0]) / 3)
+    assert np.isclose(got[1], (sd[0, 1] + sd[1, 1]) / 2)
+    assert np.allclose(got[2:4], sd[:, 2:4].mean(axis=0), rtol=1e-5)
+    assert np.isnan(got[4])
+
+
 def test_edge_heights_off_their_side_are_listed():
     """Step 7 of core/osgm/edges.py competes only cells that keep their side but lie more than tol
     from its candidate: not holes, not the cells switched or filled, not the wall heights, and only
