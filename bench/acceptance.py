@@ -781,7 +781,8 @@ def main(argv=None) -> int:
     ap.add_argument("--only", default="", help="comma-separated scene indices (default all)")
     ap.add_argument("--no-sgbm", action="store_true", help="skip the pairwise SGBM baseline")
     ap.add_argument("--realistic", action="store_true",
-                    help="also draw an optics blur and crop fields per scene (own docs section)")  # fmt: skip
+                    help="also draw an optics blur, crop fields and a real block's JPEG quality per scene "
+                         "(own docs section)")  # fmt: skip
     ap.add_argument("--keep", default="", help="keep the scenes and products in this folder")
     ap.add_argument("--write-docs", action="store_true", help=f"update the marked section of {DOCS}")
     ap.add_argument("--report", default="", help="print (and with --write-docs write) the tables of a saved "

@@ -53,7 +53,8 @@ def main(argv=None) -> int:
     blurs = _numbers(args.blur, "blur")
 
     import acceptance as acc
-    from scipy.ndimage import binary_erosion, median_filter
+    from osgm_battery import departures, roughness
+    from scipy.ndimage import binary_erosion
 
     from truortho.core.errors import InputError
     from truortho.core.ortho.pipeline import TrueOrthoConfig, true_ortho
@@ -93,8 +94,7 @@ def main(argv=None) -> int:
             tcfg = TrueOrthoConfig(resolution=res, extent=scene.extent_world())
             true_ortho(scene.orientation, out.dsm, ortho, None, occ_path, config=tcfg, image_root=folder)
             occ, _, _ = read_raster(occ_path)
-            fill = float(np.nanmedian(z)) if np.isfinite(z).any() else 0.0
-            dev = z - median_filter(np.nan_to_num(z, nan=fill), 9)
+            dev = departures(z)
             err = z - truth
             for name, m in masks:
                 m = m & np.isfinite(err)
@@ -103,7 +103,7 @@ def main(argv=None) -> int:
                     continue
                 bias = float(np.median(err[m]))
                 nmad = 1.4826 * float(np.median(np.abs(err[m] - bias)))
-                rough = 1.4826 * float(np.median(np.abs(dev[m])))
+                rough = roughness(dev, m)
                 print(f"blur {blur:g} px, {name:12s} ({100 * m.mean():.1f} % of the cells): NMAD "
                       f"{nmad / gsd:.2f} GSD, median error {bias / gsd:+.2f} GSD, "
                       f"roughness {rough / gsd:.3f} GSD, flagged {100 * float(np.mean(occ[m] == 1)):.2f} %",

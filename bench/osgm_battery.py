@@ -111,13 +111,18 @@ def _rotated(orientation, px: float, index: int):
     return o
 
 
-def _roughness(dsm: np.ndarray, edge: np.ndarray) -> float:
-    """1.4826 x the median |departure from the 9 x 9 median surface| over the cells off ``edge``."""
+def departures(dsm: np.ndarray) -> np.ndarray:
+    """The DSM's departures from its 9 x 9 median surface (NaN where it has no height; its holes
+    enter the median as the DSM's median height)."""
     from scipy.ndimage import median_filter
 
     fill = float(np.nanmedian(dsm)) if np.isfinite(dsm).any() else 0.0
-    dev = dsm - median_filter(np.nan_to_num(dsm, nan=fill), 9)
-    m = ~edge & np.isfinite(dev)
+    return dsm - median_filter(np.nan_to_num(dsm, nan=fill), 9)
+
+
+def roughness(dev: np.ndarray, cells: np.ndarray) -> float:
+    """1.4826 x the median |departure| (:func:`departures`) over ``cells`` that have one (NaN: none)."""
+    m = cells & np.isfinite(dev)
     return float(1.4826 * np.median(np.abs(dev[m]))) if m.any() else float("nan")
 
 
@@ -176,16 +181,17 @@ def main(argv=None) -> int:
         stalks = d.get("stalks", np.zeros_like(truth))
         ref = within_stalks(dsm, truth, stalks)
         f = dict(dsm_figures(dsm, ref, d["nvis"] >= 2, d["edge"], d["gsd"]), seconds=seconds)
-        f["roughness_gsd"] = _roughness(dsm, d["edge"]) / d["gsd"]
+        f["roughness_gsd"] = roughness(departures(dsm), ~d["edge"]) / d["gsd"]
         # what the edge cells off by more than 3 GSD are (shares of the edge cells)
         f.update(edge_failures(dsm, ref, d["nvis"] >= 2, d["edge"], d["gsd"], d["res"]))
         fields = ""
         if (stalks > 0).any():
             # the same figures inside and outside the crop fields
-            for name, m in (("fields", stalks > 0), ("other", stalks <= 0)):
-                g = dsm_figures(dsm, ref, (d["nvis"] >= 2) & m, d["edge"], d["gsd"])
-                f.update({f"{k}_{name}": g[k] for k in ("nmad_gsd", "flat3", "edge3")})
             # (no NMAD in the fields: any height in the stalk layer reads an error of 0 there)
+            for name, m, keys in (("fields", stalks > 0, ("flat3", "edge3")),
+                                  ("other", stalks <= 0, ("nmad_gsd", "flat3", "edge3"))):  # fmt: skip
+                g = dsm_figures(dsm, ref, (d["nvis"] >= 2) & m, d["edge"], d["gsd"])
+                f.update({f"{k}_{name}": g[k] for k in keys})
             fields = (f"; fields {float((stalks > 0).mean()):.0%}: flat3 {f['flat3_fields']:.4f} edge3 "
                       f"{f['edge3_fields']:.4f}, elsewhere nmad {f['nmad_gsd_other']:.3f} flat3 "
                       f"{f['flat3_other']:.4f} edge3 {f['edge3_other']:.4f}")

@@ -34,14 +34,21 @@ _STEP = 0.25
 _HALF = 6.0
 
 
-def edge_sigmas(path: str, n_max: int = 4000, seed: int = 0) -> np.ndarray:
-    """The point spread (sigma, px) at the straight edges of one photo (at most ``n_max`` tried)."""
+def grey(path: str) -> np.ndarray:
+    """The photo's grey levels (float32, 0-255); stops with a message naming an unreadable file."""
     import cv2
 
     im = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
     if im is None:
         raise SystemExit(f"{path}: not a readable image")
-    im = im.astype(np.float32)
+    return im.astype(np.float32)
+
+
+def edge_sigmas(im: np.ndarray, n_max: int = 4000, seed: int = 0) -> np.ndarray:
+    """The point spread (sigma, px) at the straight edges of one photo's grey levels :func:`grey`
+    (at most ``n_max`` edges tried)."""
+    import cv2
+
     gx = cv2.Sobel(im, cv2.CV_32F, 1, 0, ksize=3) / 8.0
     gy = cv2.Sobel(im, cv2.CV_32F, 0, 1, ksize=3) / 8.0
     mag = np.hypot(gx, gy)
@@ -114,8 +121,11 @@ def luma_table(path: str) -> np.ndarray | None:
 
 
 def jpeg_quality(table: np.ndarray) -> float:
-    """The IJG quality whose scaled standard table is nearest ``table`` (least squares in log, over the
-    entries the scaling does not clamp to 1); 100 when every entry is 1."""
+    """The IJG quality whose scaled standard table is nearest ``table`` (64 entries in natural order,
+    as :func:`luma_table`; least squares in log)."""
+    table = np.asarray(table, np.float64)
+    if table.shape != (64,) or not np.isfinite(table).all():
+        raise ValueError(f"jpeg_quality: expected 64 finite quantisation steps, got shape {table.shape}")
     q = np.arange(1, 101)
     scale = np.where(q < 50, 5000.0 / q, 200.0 - 2.0 * q)
     tables = np.clip(np.floor((_IJG_LUMA[None, :] * scale[:, None] + 50.0) / 100.0), 1, 255)
@@ -123,15 +133,12 @@ def jpeg_quality(table: np.ndarray) -> float:
     return float(q[int(np.argmin(err.sum(axis=1)))])
 
 
-def block_edge_ratio(path: str, share: float = 0.3) -> float:
+def block_edge_ratio(im: np.ndarray, share: float = 0.3) -> float:
     """Mean |grey-level step| across the 8-pixel block boundaries over the mean inside the blocks, both
-    axes, in the ``share`` of the photo with the least local texture (a 9 x 9 mean of the steps)."""
+    axes, in the ``share`` of the photo (grey levels, :func:`grey`) with the least local texture (a
+    9 x 9 mean of the steps)."""
     import cv2
 
-    im = cv2.imread(path, cv2.IMREAD_GRAYSCALE)
-    if im is None:
-        raise SystemExit(f"{path}: not a readable image")
-    im = im.astype(np.float32)
     across, inside = [], []
     for d in (np.abs(np.diff(im, axis=1)), np.abs(np.diff(im, axis=0)).T):
         calm = cv2.blur(d, (9, 9)) <= np.quantile(cv2.blur(d, (9, 9)), share)
@@ -153,7 +160,8 @@ def main(argv=None) -> int:
         files = sorted(glob.glob(pattern))[: args.photos]
         if not files:
             raise SystemExit(f"{pattern}: no photo matches")
-        s = np.concatenate([edge_sigmas(f) for f in files])
+        images = [grey(f) for f in files]
+        s = np.concatenate([edge_sigmas(im) for im in images])
         if not len(s):
             print(f"{pattern}: no straight edge found", flush=True)
             continue
@@ -162,7 +170,7 @@ def main(argv=None) -> int:
         tables = [luma_table(f) for f in files]
         if all(t is not None for t in tables):
             quality = np.median([jpeg_quality(t) for t in tables])
-            ratio = np.median([block_edge_ratio(f) for f in files])
+            ratio = np.median([block_edge_ratio(im) for im in images])
             jpeg = f"; JPEG quality about {quality:.0f}, block edges {ratio:.2f}x the steps inside blocks"
         print(f"{pattern}: {len(s)} edges in {len(files)} photos, sigma median {med:.2f} px "
               f"(25/75 % {q1:.2f}/{q3:.2f}){jpeg}", flush=True)  # fmt: skip

@@ -40,20 +40,20 @@ evidence that no straddling window mixes:
    66.9 -> 68.2 %, 60.8 -> 63.3 % with 4). After the first pass only the cells within
    :data:`AFFECT` of a cell that switched are decided again.
    A switch needs evidence: not when the cell's own side is judged on a single pair of views
-   (:data:`WEAK_PAIRS`) and the other side's match is one of flat patches, whose spread within
-   each view (:func:`_spread`) is below the differences between the views. On ground in a uniform
-   field beside a building, the views that see the ground are few (the fattened band hides it
-   from the others) and the roof's height, in the air above the field, agrees in every view that
-   sees the field below it; traced on a cell of the realistic battery (seed 5150 scene 6, truth
-   -0.03 m), matching gave -0.13 m and a switch took it to the roof's 11.65 m (ground cost 0.33
-   on one pair, roof 0.19 on three, patch spreads 0.03). ``bench/osgm_battery.py --realistic``
+   (:data:`WEAK_PAIRS`) and the other side's match is one of flat patches, whose spread within each
+   view (:func:`_spread`) is below the differences between the views. On ground in a uniform field
+   beside a building, the views that see the ground are few (the fattened band hides it from the
+   others) and the roof's height, in the air above the field, agrees in every view that sees the
+   field below it; traced (a scratch script) on a cell of the realistic battery (seed 5150 scene 6,
+   truth -0.03 m), matching gave -0.13 m and a switch took it to the roof's 11.65 m (ground cost
+   0.33 on one pair, roof 0.19 on three, patch spreads 0.03). ``bench/osgm_battery.py --realistic``
    on seed 5150: flat3 up on 10 of 12 scenes (scene 6 96.7 -> 97.5 %, meeting the goal; scene 8
    98.4 -> 99.1 %), edge3 up on 8 by up to 0.5 points and down on 2 by at most 0.3; on the sharp
-   scenes of seeds 5150 and 808, flat3 up by up to 0.45 points, edge3 within +0.2 / -1.1 (808
-   scene 0 86.0 -> 84.9 %, 5150 scene 8 88.4 -> 87.5 %). Either test alone cost more: a single
-   pair alone blocked, edge3 down by up to 1.9 points (808 scene 0); flat patches alone, by up
-   to 5.4 (realistic scene 7). On seed 4242, not used for the choice: flat3 up on 8 of 12 scenes
-   (up to 0.21 points), edge3 +0.8 / -0.9 (scene 8 87.6 -> 88.4 %, scene 3 86.6 -> 85.8 %).
+   scenes of seeds 5150 and 808, flat3 up by up to 0.45 points, edge3 within +0.2 / -1.1 (808 scene
+   0 86.0 -> 84.9 %, 5150 scene 8 88.4 -> 87.5 %). Either test alone cost more: a single pair alone
+   blocked, edge3 down by up to 1.9 points (808 scene 0); flat patches alone, by up to 5.4
+   (realistic scene 7). On seed 4242, not used for the choice: flat3 up on 8 of 12 scenes (up to
+   0.21 points), edge3 +0.8 / -0.9 (scene 8 87.6 -> 88.4 %, scene 3 86.6 -> 85.8 %).
 6. **Holes and wall heights**: a cell near a step that matching left empty (no clear minimum, or
    one rejected by the uniqueness or median test: typically the foot of a wall or the rim of a
    roof), takes the more photo-consistent side, with at least one pair of views on each side, and
