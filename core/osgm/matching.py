@@ -17,7 +17,9 @@ never computed.
    on the cells that search that level and the margin their windows read
    (:mod:`.sweep`, the default saturated-gradient measure: every image
    sampled there, all of them compared at once, mean of the best pairs:
-   robust to the views that are occluded there); the other measures
+   robust to the views that are occluded there; near a height step of the
+   coarser surface, on the levels above the finest, the number of best pairs
+   counts only the views that see the step's foot: :func:`hidden_views`); the other measures
    resample every image onto the bounding box of those cells
    (:func:`~.views.plane_map` + ``cv2.remap``) and call
    :func:`~truortho.core.sgm.multi_image_cost`. The gradients' saturation
@@ -81,6 +83,7 @@ class TileParams:
     rim_view_angle: float = 0.0  # steeper views, only where the others leave points short (0 = off)
     slope_max: int = 0  # SGM follows the coarser surface's slopes up to this many levels per cell (0 = off)
     adaptive_p2: bool = True  # P2 adapts to the image gradient of the coarser surface (needs ``guide_z``)
+    occlusion_pairs: bool = False  # near a step of the coarser surface, best pairs of the views it leaves
 
 
 #: Cells of the box mean that smooths the coarser surface into the trend (:func:`slope_trend`).
@@ -511,10 +514,68 @@ def _dense_sweep(
     return evaluated
 
 
+#: Side (cells of the level) of the neighbourhood whose lowest and highest heights on the coarser
+#: surface tell a cell near a height step (:func:`hidden_views`): the refined bands' 5 x 5 coarser
+#: cells (:mod:`.levels`) are 9 to 10 of the level's.
+OCCLUSION_WINDOW = 9
+
+
+def hidden_views(images, x0, y0, res, guide_z, search, dz):
+    """The views that the coarser surface hides from the ground beside a height step.
+
+    A cell whose :data:`OCCLUSION_WINDOW` neighbourhood on the coarser surface ``guide_z`` (local
+    heights at the tile's cells) spans more than a step (``max(1 m, 4 dz)``, as the edge
+    refinement's) may lie on the low side: ground at the foot of a wall, which the views on the far
+    side of the building cannot see. For each view, the ray from the cell at the neighbourhood's
+    lowest height is marched over the coarser surface (:func:`~.edges._ray_free`: from
+    :data:`~.edges.NEAR` cells on, so that a band the coarser level fattened beside the wall does
+    not hide the ground from the very views that show it; tolerance ``2 dz``).
+
+    Returns ``(occ, hid)``: ``occ`` (rows, cols) uint8, 1 at the searching cells with at least one
+    view hidden, and ``hid`` (rows, cols, V) uint8 the hidden views there; None where no cell of the
+    tile is near a step. The plane sweep takes the best pairs at such a cell as if only the views
+    not hidden were valid (:func:`~.sweep._block_sums`): every pair still competes, at every height.
+    """
+    from scipy.ndimage import maximum_filter
+
+    from .edges import BLOCK, NEAR, _ray_free, block_max
+
+    g = np.asarray(guide_z, np.float64)
+    rows, cols = g.shape
+    fin = np.isfinite(g)
+    if len(images) < 3 or not fin.any():
+        return None
+    zmax = maximum_filter(np.where(fin, g, -np.inf), OCCLUSION_WINDOW, mode="nearest")
+    zmin = -maximum_filter(np.where(fin, -g, -np.inf), OCCLUSION_WINDOW, mode="nearest")
+    cells = np.asarray(search, bool) & np.isfinite(zmin) & np.isfinite(zmax)
+    cells &= zmax - zmin > max(1.0, 4.0 * dz)
+    if not cells.any():
+        return None
+    ri, ci = np.nonzero(cells)
+    ri = ri.astype(np.int64)
+    ci = ci.astype(np.int64)
+    zc = np.ascontiguousarray(zmin[cells])
+    zz = np.ascontiguousarray(np.where(fin, g, np.nan))
+    bmax = block_max(zz)
+    ztop = float(np.nanmax(zz))
+    hid = np.zeros((rows, cols, len(images)), np.uint8)
+    free = np.empty(ri.size, np.bool_)
+    for v, img in enumerate(images):
+        C = np.ascontiguousarray(img.view.C, np.float64)
+        _ray_free(zz, bmax, BLOCK, ri, ci, zc, x0, y0, res, C, 2.0 * dz, ztop, float(NEAR), free)
+        hid[ri, ci, v] = ~free
+    occ = np.ascontiguousarray(hid.any(axis=2), np.uint8)
+    if not occ.any():
+        return None
+    return occ, hid
+
+
 def _sweep(
-    images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps=None
+    images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps=None,
+    hidden=None,
 ) -> int:
-    """Costs plane by plane on the cells that search each plane only (:mod:`.sweep`, gradient measure)."""
+    """Costs plane by plane on the cells that search each plane only (:mod:`.sweep`, gradient measure);
+    ``hidden``: :func:`hidden_views` (None: none)."""
     from ..sgm.cost import DEFAULT_MIN_VALID
     from .sweep import PlaneSweep, gradient_scales
 
@@ -530,7 +591,7 @@ def _sweep(
         need = _plane_need(search, lo, hi, gaps, a)
         if not need.any():
             continue
-        sweep.plane(x0, y0, res, z_base + a * dz, need, a, z0, cost)
+        sweep.plane(x0, y0, res, z_base + a * dz, need, a, z0, cost, hidden=hidden)
         evaluated += 1
     return evaluated
 
@@ -716,9 +777,13 @@ def match_tile(
     z0 = np.where(search, np.maximum(z0, hi - nd + 1), 0).astype(np.int32)
     cost = np.full((rows, cols, nd), COST_MAX, np.uint16)
     sweep = _sweep if params.measure == "gradient" and SPARSE_SWEEP else _dense_sweep
+    hidden = None
+    if params.occlusion_pairs and guide_z is not None and sweep is _sweep:
+        hidden = hidden_views(images, x0, y0, res, guide_z, search, dz)
     evaluated = sweep(
-        images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps
-    )
+        images, x0, y0, res, search, lo, hi, z0, z_base, dz, a_min, a_max, params, cost, cancelled, gaps,
+        **({"hidden": hidden} if hidden is not None else {}),
+    )  # fmt: skip
     fill_unseen(cost, lo, hi, z0, gaps)
     guide = None
     if params.adaptive_p2 and guide_z is not None:

@@ -128,6 +128,12 @@ class OsgmConfig:
         Re-decide the side of every cell near a height step on the finest
         level with occlusion-aware 3 x 3 photo-consistency (:mod:`.edges`):
         against the fattening of window matching at building outlines.
+    occlusion_pairs : bool
+        On the refined levels above the finest, a cell near a height step of the coarser level
+        takes the best pairs of views as if the views that the coarser surface hides from the foot
+        of the step were not there (:func:`~.matching.hidden_views`): its ground is then judged on
+        the pairs that see it, not outvoted by a roof's height over a uniform field. Gradient
+        measure only.
     slope_max : int
         Below the coarsest level, SGM follows the coarser level's slopes up to this many Z levels
         per cell (:func:`~.matching.slope_trend`): slanted roofs are not flattened by P1; 0 = off.
@@ -182,6 +188,7 @@ class OsgmConfig:
     uniqueness: float = 0.99
     median: int = 3
     refine_edges: bool = True
+    occlusion_pairs: bool = True
     slope_max: int = 2
     band: int | None = None
     max_levels: int = 5
@@ -267,6 +274,7 @@ class OsgmConfig:
             edges=bool(self.refine_edges),
             slope_max=int(self.slope_max),
             adaptive_p2=bool(self.adaptive_p2),
+            occlusion_pairs=bool(self.occlusion_pairs),
         )
 
 

@@ -32,7 +32,8 @@ same arithmetic as the dense saturated-gradient cost
    contributions ``min(1, mean (|dgx| + |dgy|) / 2)`` and the mean of the
    best pairs (as :func:`~truortho.core.sgm.cost._combine`, found by bisection:
    :func:`_smallest_mean`), written straight into the tile's cost volume
-   (:func:`_block_sums`).
+   (:func:`_block_sums`); at the cells where the coarser surface hides views
+   (:func:`~.matching.hidden_views`), the number of best pairs counts only the views left.
 
 Why blocks: a coarse tile that spans a whole block of photos holds photos from
 its opposite ends (36 photos and 630 pairs on the coarsest levels of battery
@@ -554,7 +555,7 @@ def _smallest_mean(v, kb):
 
 @njit
 def _block_sums(
-    tp, unit, sh, vv, need, win, blk, t0, e0, radius, min_valid, best_k, pi, pj, a, z0, cost, work
+    tp, unit, sh, vv, need, win, blk, t0, e0, radius, min_valid, best_k, pi, pj, a, z0, cost, work, occ, hid
 ):
     """Window sums of the packed pair terms ``tp`` (the block's, indexed from ``t0, e0``) at the
     cells with ``need`` of the block ``blk`` ``[r0, r1, c0, c1]``, and the multi-image cost from
@@ -569,6 +570,10 @@ def _block_sums(
     plane of battery scene 9: 52 -> 41 ms on one thread). ``_combine`` keeps its quickselect: its
     NCC and census contributions are not multiples of a common quantum, so there the order of the
     additions could change the last bit.
+
+    ``occ`` (rows, cols) marks the cells where ``hid`` (rows, cols, n) lists views that the coarser
+    surface hides (:func:`~.matching.hidden_views`): there the number of best pairs counts only the
+    valid views that are not hidden (at least two), all pairs still competing.
     """
     rows, cols = need.shape
     nt = pi.shape[0]
@@ -623,6 +628,12 @@ def _block_sums(
                 ok = hc[i] >= k
                 vok[i] = ok
                 nv += ok
+            nk = nv
+            if occ[r, c]:
+                for i in range(n):
+                    if vok[i] and hid[r, c, i]:
+                        nk -= 1
+                nk = max(nk, 2)
             kk = a - z0[r, c]
             if nv < 2:
                 cost[r, c, kk] = COST_MAX
@@ -637,7 +648,7 @@ def _block_sums(
             if m == 0:
                 cost[r, c, kk] = COST_MAX
                 continue
-            kb = best_k if best_k > 0 else _auto_k(nv)
+            kb = best_k if best_k > 0 else _auto_k(nk)
             if kb >= m:
                 mean = _sum_le(val, 1.0) / m
             else:
@@ -677,7 +688,7 @@ def _views(work, wc, nt, n):
 
 @pjit
 def _block_cost(
-    qx, qy, vv, need, win, blocks, workers, radius, min_valid, best_k, pi, pj, unit, sh, a, z0, cost
+    qx, qy, vv, need, win, blocks, workers, radius, min_valid, best_k, pi, pj, unit, sh, a, z0, cost, occ, hid
 ):
     """The costs of the cells with ``need`` in every block of ``blocks``, each block with only the
     pairs that meet in it (:func:`_block_pairs`); ``workers`` threads take the blocks in turn."""
@@ -707,8 +718,9 @@ def _block_cost(
             _block_terms(qx, qy, vv, win, t0, t1, e0, e1, oi[:m], oj[:m], unit[0], tp)
             bi, bj = oi[:m], oj[:m]
             _block_sums(
-                tp, unit, sh, vv, need, win, blk, t0, e0, radius, min_valid, best_k, bi, bj, a, z0, cost, work
-            )
+                tp, unit, sh, vv, need, win, blk, t0, e0, radius, min_valid, best_k, bi, bj, a, z0, cost,
+                work, occ, hid,
+            )  # fmt: skip
 
 
 def _packing(radius: int) -> tuple[np.ndarray, int]:
@@ -773,15 +785,20 @@ class PlaneSweep:
         self.samp = np.empty((rows, cols), np.uint8)
         self.win = np.empty((rows, cols), np.uint8)
         self.unit, self.sh = _packing(self.radius)
+        #: no view hidden anywhere (:meth:`plane` without ``hidden``; ``no_hid`` is never read)
+        self.no_occ = np.zeros((rows, cols), np.uint8)
+        self.no_hid = np.zeros((1, 1, n), np.uint8)
 
     def plane(
-        self, x0, y0, res, z, need: np.ndarray, a: int, z0: np.ndarray, cost: np.ndarray, best_k=0
+        self, x0, y0, res, z, need: np.ndarray, a: int, z0: np.ndarray, cost: np.ndarray, best_k=0,
+        hidden=None,
     ) -> None:
         """Costs of plane ``z`` (absolute level ``a``) for the cells with ``need`` into ``cost``.
 
         ``need`` (rows, cols) bool; ``z0`` (rows, cols) int32 and ``cost`` (rows, cols, nd) uint16,
         C-ordered (written in place), with ``0 <= a - z0 < nd`` wherever ``need`` is set (the
-        caller's per-cell windows guarantee it; the kernels do not check it again).
+        caller's per-cell windows guarantee it; the kernels do not check it again). ``hidden``:
+        ``(occ, hid)`` of :func:`~.matching.hidden_views` (None: no view hidden).
         """
         shape = self.samp.shape
         if np.shape(need) != shape or np.shape(z0) != shape:
@@ -797,6 +814,22 @@ class PlaneSweep:
             or not cost.flags.c_contiguous
         ):
             raise InputError(f"PlaneSweep.plane: cost must be a C-ordered uint16 {shape} x nd volume")
+        if hidden is None:
+            occ, hid = self.no_occ, self.no_hid
+        else:
+            occ, hid = hidden
+            n = self.vv.shape[2]
+            if (
+                np.shape(occ) != shape
+                or np.shape(hid) != (*shape, n)
+                or occ.dtype != np.uint8
+                or hid.dtype != np.uint8
+                or not (occ.flags.c_contiguous and hid.flags.c_contiguous)
+            ):
+                raise InputError(
+                    f"PlaneSweep.plane: hidden must be C-ordered uint8 {shape} and {(*shape, n)} arrays, "
+                    f"got {np.shape(occ)} and {np.shape(hid)}"
+                )
         need8 = np.ascontiguousarray(need, np.uint8)
         box = np.array(_box(need8, self.radius + 1), np.int64)
         if box[1] <= box[0]:
@@ -813,5 +846,5 @@ class PlaneSweep:
         workers = max(1, min(numba.get_num_threads(), len(blocks)))
         _block_cost(
             self.qx, self.qy, self.vv, need8, self.win, blocks, workers, self.radius, self.min_valid,
-            int(best_k or 0), self.pi, self.pj, self.unit, self.sh, int(a), z0, cost,
+            int(best_k or 0), self.pi, self.pj, self.unit, self.sh, int(a), z0, cost, occ, hid,
         )  # fmt: skip

@@ -118,14 +118,21 @@ def test_the_finest_level_tiles_overlap_less():
 
 def test_coarse_levels_keep_near_ties():
     """Only the finest level rejects near-ties (uniqueness); coarser levels keep them as guides,
-    with P2 scaled to their cells and no edge refinement."""
+    with P2 scaled to their cells and no edge refinement. The occlusion-aware count of best pairs
+    is for the coarser levels only."""
+    import dataclasses
+
     grid = RasterGrid(0.0, 100.0, 0.25, 400, 400)
     plan = plan_levels(-5.0, 55.0, 0.25, grid)
     params = OsgmConfig(uniqueness=0.9).tile_params()
-    assert plan.level_params(params, 0) == params
+    assert params.occlusion_pairs
+    assert plan.level_params(params, 0) == dataclasses.replace(params, occlusion_pairs=False)
     for lv in (1, 2):
         p = plan.level_params(params, lv)
         assert p.uniqueness == 1.0 and p.p2 == round(params.p2 / 2**lv) and not p.edges
+        assert p.occlusion_pairs
+    off = OsgmConfig(occlusion_pairs=False).tile_params()
+    assert plan.level_params(off, 0) == off and not plan.level_params(off, 1).occlusion_pairs
 
 
 def test_refined_bands_skip_the_heights_between_two_surfaces():
@@ -1285,3 +1292,38 @@ def test_summary_explains_an_empty_dsm():
     assert "Nothing matched" in nothing and "Z_MIN/Z_MAX" in nothing and "POINT_CLOUD" in nothing
     fine = OsgmResult(grid, dict(base, completeness=0.97, systems=[nadir, side])).summary()
     assert "empty" not in fine and "Nothing" not in fine and "97.00 %" in fine
+
+
+def test_hidden_views_are_those_the_coarser_surface_hides_from_the_foot_of_a_step():
+    """core/osgm/matching.py hidden_views: near a height step of the coarser surface, the views whose
+    ray from the neighbourhood's lowest height passes under the surface (beyond the cells next to
+    the one decided); none far from steps, on a roof's middle, at cells that do not search, with
+    fewer than three views or on flat ground."""
+    from types import SimpleNamespace
+
+    from truortho.core.osgm.matching import OCCLUSION_WINDOW, hidden_views
+
+    res, dz = 0.5, 0.25
+    guide = np.zeros((60, 60))
+    guide[20:40, 30:50] = 10.0  # a building x 15..25 m, y -10..-20 m (y = -(row + 0.5) res)
+    cams = [(60.0, -15.0, 100.0), (-30.0, -15.0, 100.0), (20.0, -15.0, 100.0)]  # east, west, above
+    images = [SimpleNamespace(view=SimpleNamespace(C=np.array(c))) for c in cams]
+    search = np.ones(guide.shape, bool)
+    search[50:, :] = False
+    occ, hid = hidden_views(images, 0.0, 0.0, res, guide, search, dz)
+    assert occ.shape == guide.shape and hid.shape == (*guide.shape, 3)
+    # ground 1.25 m west of the wall: the roof hides it from the east, not from the west or above
+    assert occ[30, 27] == 1 and hid[30, 27].tolist() == [1, 0, 0]
+    # ground 1.25 m east of the wall: hidden from the west only
+    assert hid[30, 52].tolist() == [0, 1, 0]
+    # the roof's rim holds the ground in its neighbourhood as well: the same views
+    assert hid[30, 31].tolist() == [1, 0, 0]
+    # far from the step, in the middle of the roof (its neighbourhood all roof) and where no search
+    half = OCCLUSION_WINDOW // 2
+    assert occ[5, 5] == 0 and occ[30, 40] == 0 and 40 - half > 30
+    guide2 = guide.copy()
+    guide2[52:56, 10:14] = 10.0
+    occ2, _ = hidden_views(images, 0.0, 0.0, res, guide2, search, dz)
+    assert not occ2[50:].any()
+    assert hidden_views(images[:2], 0.0, 0.0, res, guide, search, dz) is None
+    assert hidden_views(images, 0.0, 0.0, res, np.zeros((30, 30)), np.ones((30, 30), bool), dz) is None

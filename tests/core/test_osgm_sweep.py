@@ -182,8 +182,9 @@ def test_sweep_kernels_without_the_jit():
         sw._block_terms.py_func(p.qx, p.qy, p.vv, p.win, t0, t1, e0, e1, oi[:m], oj[:m], p.unit[0], tp)
         work = sw._work_arrays.py_func(e1 - e0, m, len(images), p.unit)
         sw._block_sums.py_func(
-            tp, p.unit, p.sh, p.vv, need8, p.win, blk, t0, e0, 1, 0.5, 0, oi[:m], oj[:m], 0, z0, got, work
-        )
+            tp, p.unit, p.sh, p.vv, need8, p.win, blk, t0, e0, 1, 0.5, 0, oi[:m], oj[:m], 0, z0, got, work,
+            p.no_occ, p.no_hid,
+        )  # fmt: skip
     assert np.array_equal(got, want)
     assert np.all(got[need] < 9999) and np.all(got[~need] == 9999)
 
@@ -347,3 +348,45 @@ def test_frame_columns_stay_inside_the_row():
             inside = (zc > 0) & (x >= fb[0]) & (x <= fb[1]) & (y >= fb[2]) & (y <= fb[3])
         cols = np.arange(c0, c1)[inside]
         assert np.all((cols >= ca) & (cols < cb)), (trial, ca, cb, cols)
+
+
+def test_views_hidden_by_the_coarser_surface_leave_fewer_best_pairs():
+    """At a cell with hidden views (core/osgm/matching.py hidden_views) the sweep takes the best pairs
+    as if only the views left were valid (at least two), every pair still competing: the dense cost
+    with that number of best pairs; elsewhere the cost stays the same to the bit."""
+    from truortho.core.errors import InputError
+    from truortho.core.sgm.cost import _auto_k
+
+    rng = np.random.default_rng(21)
+    n, rows, cols = 6, 40, 44
+    images = _images(rng, n, rows, cols)
+    scales = gradient_scales(images, _remap, 0.0, 0.0, RES, rows, cols, Z)
+    slices = np.stack([_remap(im, 0.0, 0.0, RES, rows, cols, Z) for im in images])
+    dense, nv = multi_image_cost(slices, 2, measure="gradient", scales=scales)
+    occ = np.zeros((rows, cols), np.uint8)
+    hid = np.zeros((rows, cols, n), np.uint8)
+    occ[5:20, 5:30] = 1
+    hid[5:20, 5:30, :2] = 1  # two of six hidden: the best pairs of four views
+    occ[25:35, 10:40] = 1
+    hid[25:35, 10:40, :5] = 1  # five hidden: the best pair (never fewer than two views)
+    need = np.ones((rows, cols), bool)
+    z0 = np.zeros((rows, cols), np.int32)
+    cost = np.full((rows, cols, 1), 9999, np.uint16)
+    sweep = PlaneSweep(images, rows, cols, 2, 0.5, scales)
+    sweep.plane(0.0, 0.0, RES, Z, need, 0, z0, cost, hidden=(occ, hid))
+    got = cost[:, :, 0]
+    full = nv == n
+    for sl, k in ((np.s_[5:20, 5:30], _auto_k(4)), (np.s_[25:35, 10:40], _auto_k(2))):
+        want, _ = multi_image_cost(slices, 2, measure="gradient", scales=scales, best_k=k)
+        cells = np.zeros((rows, cols), bool)
+        cells[sl] = True
+        cells &= full
+        assert cells.sum() > 100
+        assert np.array_equal(got[cells], want[cells])
+        assert (got[cells] < dense[cells]).mean() > 0.5  # fewer best pairs: lower means
+    assert np.array_equal(got[occ == 0], dense[occ == 0])
+    # the same plane without hidden views is the dense cost everywhere
+    sweep.plane(0.0, 0.0, RES, Z, need, 0, z0, cost)
+    assert np.array_equal(cost[:, :, 0], dense)
+    with pytest.raises(InputError, match="hidden"):
+        sweep.plane(0.0, 0.0, RES, Z, need, 0, z0, cost, hidden=(occ, hid[:, :, :3]))
