@@ -414,8 +414,8 @@ class _LevelTasks(Sequence):
                 lo, hi = refine_windows(plan, lv, self.prev_z, (r0, c0, nr, nc))
                 glo = ghi = None
             assert self.prev_filled is not None
-            # the coarser surface, for the adaptive P2's guide and for the slope trend
-            wanted = self.cfg.adaptive_p2 or self.cfg.slope_max > 0
+            # the coarser surface, for the adaptive P2's guide, the slope trend and the hidden views
+            wanted = self.cfg.adaptive_p2 or self.cfg.slope_max > 0 or self.cfg.occlusion_pairs
             guide = _interpolate(self.prev_filled, (r0, c0, nr, nc)) if wanted else None
         search = lo <= hi
         nd = int(max(3, (hi - lo + 1)[search].max())) if search.any() else 0

@@ -1030,7 +1030,9 @@ def test_slope_trend_and_adaptive_p2_are_independent(small_scene, monkeypatch, a
 
     scene, folder = small_scene
     o = scene.orientation
-    cfg = OsgmConfig(adaptive_p2=adaptive_p2, slope_max=slope_max, refine_edges=False, median=1)
+    cfg = OsgmConfig(
+        adaptive_p2=adaptive_p2, slope_max=slope_max, refine_edges=False, median=1, occlusion_pairs=False
+    )
     params = cfg.tile_params()
     assert (params.adaptive_p2, params.slope_max) == (adaptive_p2, slope_max)
     views = system_views(o, reference_systems(o, "none", 35.0)[0])
@@ -1080,6 +1082,9 @@ def test_slope_trend_and_adaptive_p2_are_independent(small_scene, monkeypatch, a
     monkeypatch.setattr(pl, "_interpolate", lambda coarse, w: np.zeros(w[2:], np.float32))
     tasks = _LevelTasks(tiles, g, 0, Plan(), params, cfg, prev, prev, None, 0)
     assert (tasks[0].guide is not None) == (adaptive_p2 or slope_max > 0)
+    # the hidden views (occlusion_pairs) need the coarser surface as well, whatever the other two
+    on = OsgmConfig(adaptive_p2=adaptive_p2, slope_max=slope_max, occlusion_pairs=True)
+    assert _LevelTasks(tiles, g, 0, Plan(), on.tile_params(), on, prev, prev, None, 0)[0].guide is not None
 
 
 def test_slope_trend_follows_a_roof_down_to_its_eaves_but_not_along_a_gable():
