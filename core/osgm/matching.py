@@ -536,17 +536,22 @@ def hidden_views(images, x0, y0, res, guide_z, search, dz):
     tile is near a step. The plane sweep takes the best pairs at such a cell as if only the views
     not hidden were valid (:func:`~.sweep._block_sums`): every pair still competes, at every height.
     """
-    from scipy.ndimage import maximum_filter
-
     from .edges import BLOCK, NEAR, _ray_free, block_max
+    from .levels import neighbourhood_minmax
 
     g = np.asarray(guide_z, np.float64)
+    if g.ndim != 2 or np.shape(search) != g.shape:
+        raise InputError(
+            "hidden_views: expected 2-D guide_z and search of one shape, got "
+            f"{g.shape} and {np.shape(search)}"
+        )
+    if not (np.isfinite(res) and res > 0 and np.isfinite(dz) and dz > 0):
+        raise InputError(f"hidden_views: expected res > 0 and dz > 0, got {res!r} and {dz!r}")
     rows, cols = g.shape
     fin = np.isfinite(g)
     if len(images) < 3 or not fin.any():
         return None
-    zmax = maximum_filter(np.where(fin, g, -np.inf), OCCLUSION_WINDOW, mode="nearest")
-    zmin = -maximum_filter(np.where(fin, -g, -np.inf), OCCLUSION_WINDOW, mode="nearest")
+    zmin, zmax = neighbourhood_minmax(g, OCCLUSION_WINDOW // 2)
     cells = np.asarray(search, bool) & np.isfinite(zmin) & np.isfinite(zmax)
     cells &= zmax - zmin > max(1.0, 4.0 * dz)
     if not cells.any():

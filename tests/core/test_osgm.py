@@ -1331,4 +1331,8 @@ def test_hidden_views_are_those_the_coarser_surface_hides_from_the_foot_of_a_ste
     occ2, _ = hidden_views(images, 0.0, 0.0, res, guide2, search, dz)
     assert not occ2[50:].any()
     assert hidden_views(images[:2], 0.0, 0.0, res, guide, search, dz) is None
+    with pytest.raises(InputError, match="hidden_views.*shape"):
+        hidden_views(images, 0.0, 0.0, res, guide, search[:10], dz)
+    with pytest.raises(InputError, match="hidden_views.*dz"):
+        hidden_views(images, 0.0, 0.0, res, guide, search, 0.0)
     assert hidden_views(images, 0.0, 0.0, res, np.zeros((30, 30)), np.ones((30, 30), bool), dz) is None
