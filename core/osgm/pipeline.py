@@ -38,6 +38,7 @@ import numpy as np
 from ..errors import CancelledError, InputError
 from ..geometry.frame import parse_crs, require_metric
 from ..grid import RasterGrid
+from ..optics import MAX_SPREAD
 from ..orientation import Orientation, as_orientation
 from ..parallel import (
     EXECUTORS,
@@ -56,7 +57,7 @@ from .levels import MAX_BAND, LevelPlan, coarse_windows, plan_levels, refine_ban
 from .matching import TileParams, choose_images, sample_surface
 from .systems import reference_systems, system_views
 from .tiles import TileContext, TileTask, assemble_tiles, osgm_tile_task, task_memory
-from .views import ImagePyramid, check_images
+from .views import ImagePyramid, check_images, photo_spreads
 from .zrange import check_overlap, default_extent, default_resolution, known_heights, surface_range, z_range
 
 DSM_NODATA = -9999.0
@@ -138,6 +139,11 @@ class OsgmConfig:
         Below the coarsest level, SGM follows the coarser level's slopes up to this many Z levels
         per cell (:func:`~.matching.slope_trend`): slanted roofs are not flattened by P1; 0 = off.
         Independent of ``adaptive_p2``: the coarser surface reaches the tiles when either needs it.
+    point_spread : float, optional
+        The photos' Gaussian point spread (px) beyond a sharp photo's, undone in the matching band
+        before matching (:func:`~truortho.core.optics.restore`: where the detail stands above the
+        noise). None: measured per camera on the photos' straight edges (:func:`photo_spreads`);
+        0: the photos are matched as they are.
     band : int, optional
         0-based band to match on; default the luminance.
     max_levels : int
@@ -190,6 +196,7 @@ class OsgmConfig:
     refine_edges: bool = True
     occlusion_pairs: bool = True
     slope_max: int = 2
+    point_spread: float | None = None
     band: int | None = None
     max_levels: int = 5
     chunk_memory: int = 1 << 30
@@ -225,6 +232,13 @@ class OsgmConfig:
         if isinstance(sm, bool) or not isinstance(sm, int) or not 0 <= sm <= 16:
             raise InputError(f"slope_max: expected an integer number of Z levels per cell in [0, 16], "
                              f"got {self.slope_max!r}")  # fmt: skip
+        ps = self.point_spread
+        if ps is not None and (
+            isinstance(ps, bool)
+            or not isinstance(ps, int | float)
+            or not (math.isfinite(ps) and 0 <= ps <= MAX_SPREAD)
+        ):
+            raise InputError(f"point_spread: expected None (measured) or px in [0, {MAX_SPREAD}], got {ps!r}")
         p1 = DEFAULT_P1 if self.p1 is None else int(self.p1)
         p2 = DEFAULT_P2 if self.p2 is None else int(self.p2)
         if not (0 <= p1 < p2 <= P2_MAX):
@@ -326,6 +340,10 @@ class OsgmResult:
         for sysd in s.get("systems", [])[1:]:
             text += f"; system {sysd['id']} ({sysd['name']}): {sysd['points']} points"
             oblique += int(sysd["points"])
+        for cam, d in s.get("point_spread", {}).items():
+            if d["restored"] > 0:
+                measured = "" if d["measured"] is None else f" (measured {d['measured']:.2f} px)"
+                text += f"; photos of {cam} restored by a point spread of {d['restored']:.2f} px{measured}"
         if s["completeness"] <= 0.0:
             # an empty DSM reads like a failure; say why and where the result is
             if oblique:
@@ -463,7 +481,10 @@ def _match_system(
     executor = executor or InProcessExecutor()
     params = cfg.tile_params()
     views = system_views(o, system)
-    ctx = TileContext(tuple(pyr.paths), tuple(pyr.sizes), pyr.band, pyr.max_bytes, views, pyramid=pyr)
+    ctx = TileContext(
+        tuple(pyr.paths), tuple(pyr.sizes), pyr.band, pyr.max_bytes, views, pyr.spread, pyr.window_px,
+        pyramid=pyr,
+    )  # fmt: skip
     base = ""
     if cache is not None:
         base = Digest(cache_base, ctx.digest().hexdigest(), np.asarray(system.Q, np.float64)).hexdigest()
@@ -661,7 +682,14 @@ def run_osgm(
     check_overlap(o, grid, ground)
     off = o.offset
     local = RasterGrid(grid.x_min - off[0], grid.y_max - off[1], res, grid.rows, grid.cols, o.crs)
-    pyr = ImagePyramid(paths, sizes, cfg.band, cfg.cache_bytes)
+    if cfg.point_spread is None:
+        cams = [im.camera for im in o.images]
+        spread, spread_report = photo_spreads(paths, sizes, cams, cfg.band, progress)
+    else:
+        spread = [float(cfg.point_spread)] * len(paths)
+        spread_report = {"given": {"measured": None, "photos": 0, "restored": float(cfg.point_spread)}}
+    pyr = ImagePyramid(paths, sizes, cfg.band, cfg.cache_bytes, spread, 2 * int(cfg.radius) + 1)
+    pyr.spread_report = spread_report
     # everything a tile's result depends on besides its own inputs: block, parameters, grid, Z surface
     cache_base = Digest(
         "osgm-run",
@@ -871,6 +899,7 @@ class _RunInfo:
             "systems": systems,
             "images": len(self.o.images),
             "image_reads": self.pyr.reads,
+            "point_spread": getattr(self.pyr, "spread_report", {}),
             "executor": ex.describe() if hasattr(ex, "describe") else type(ex).__name__,
             "cache_hits": self.cache.hits,
             "cache_tiles_written": self.cache.written,

@@ -49,6 +49,10 @@ class TileContext:
     band: int | None
     cache_bytes: int
     views: list[View]
+    #: per image, the point spread its matching band is restored by (``ImagePyramid.spread``)
+    spread: tuple[float, ...] = ()
+    #: the restoration's window (``ImagePyramid.window_px``)
+    window: int = 5
     #: the run's own pyramid, used in this process; never pickled (workers open their own)
     pyramid: ImagePyramid | None = field(default=None, compare=False)
 
@@ -58,13 +62,17 @@ class TileContext:
         return state
 
     def pyramid_key(self) -> tuple:
-        return (tuple(self.paths), tuple(tuple(s) for s in self.sizes), self.band, int(self.cache_bytes))
+        return (
+            tuple(self.paths), tuple(tuple(s) for s in self.sizes), self.band, int(self.cache_bytes),
+            tuple(self.spread), int(self.window),
+        )  # fmt: skip
 
     def digest(self) -> Digest:
         """Identity of the inputs: image files (path, size, mtime), views, band."""
         d = Digest(
-            "osgm-context", [file_identity(p) for p in self.paths], [list(s) for s in self.sizes], self.band
-        )
+            "osgm-context", [file_identity(p) for p in self.paths], [list(s) for s in self.sizes], self.band,
+            [float(v) for v in self.spread], int(self.window),
+        )  # fmt: skip
         for v in self.views:
             d.add(
                 [
@@ -207,7 +215,10 @@ def worker_pyramid(ctx: TileContext) -> ImagePyramid:
     if ctx.pyramid is not None:
         return ctx.pyramid
     return _PYRAMIDS.get(
-        ctx.pyramid_key(), lambda: ImagePyramid(list(ctx.paths), list(ctx.sizes), ctx.band, ctx.cache_bytes)
+        ctx.pyramid_key(),
+        lambda: ImagePyramid(
+            list(ctx.paths), list(ctx.sizes), ctx.band, ctx.cache_bytes, ctx.spread or None, ctx.window
+        ),
     )
 
 

@@ -15,7 +15,9 @@ back and would map far-away object points into the frame.
 image at the reduced level whose pixel is closest to (not larger than) the
 object cell, by windows: tiled GeoTIFF/VRT/JPEG 2000 sources are read window
 by window at that level (rasterio uses their overviews), other formats are
-decoded once and kept in a least-recently-used cache bounded in bytes.
+decoded once and kept in a least-recently-used cache bounded in bytes. With a point spread per
+image (``spread``), the matching band is restored towards a sharp photo's spread at every level
+(:func:`~truortho.core.optics.restore`, the spread halved per level) before it is served.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from ..imagery import (
     read_level_window,
 )
 from ..jit import njit
+from ..optics import MAX_SPREAD, MIN_RESTORE, excess_spread, photo_spread, restore, restore_margin
 
 
 def monotonic_radius2(camera: Camera, limit: float = 4.0) -> float:
@@ -155,13 +158,36 @@ class ImagePyramid:
         bands, or the first band).
     max_bytes : int
         Budget of the cache of decoded images.
+    spread : sequence of float, optional
+        Per image, the Gaussian point spread (px at full resolution) to undo in the matching band
+        (:func:`~truortho.core.optics.restore`; 0 or None: served as decoded). Colours are never
+        restored.
+    window : int
+        The restoration's window (px, odd): the matching window's width.
     """
 
-    def __init__(self, paths, sizes, band: int | None = None, max_bytes: int = 1 << 30) -> None:
+    def __init__(
+        self, paths, sizes, band: int | None = None, max_bytes: int = 1 << 30, spread=None, window: int = 5
+    ) -> None:
         self.paths = [str(p) for p in paths]
         self.sizes = [tuple(int(v) for v in s) for s in sizes]
         self.band = band
         self.max_bytes = int(max_bytes)
+        if spread is None:
+            spread = [0.0] * len(self.paths)
+        self.spread = tuple(float(v) for v in spread)
+        if len(self.spread) != len(self.paths) or not all(
+            math.isfinite(v) and 0.0 <= v <= MAX_SPREAD for v in self.spread
+        ):
+            raise InputError(
+                f"ImagePyramid: spread must give one number in [0, {MAX_SPREAD}] px per image "
+                f"({len(self.paths)}), got {list(spread)!r}"
+            )
+        if int(window) != window or window < 1 or window % 2 == 0:
+            raise InputError(f"ImagePyramid: window must be an odd number of pixels >= 1, got {window!r}")
+        self.window_px = int(window)
+        #: what the run measured and restored, per camera (set by the OSGM run; for its statistics)
+        self.spread_report: dict = {}
         self._cache: OrderedDict = OrderedDict()
         self._bytes = 0
         self.reads = 0
@@ -184,9 +210,16 @@ class ImagePyramid:
         # only the level asked for is cached (JPEGs decode directly at up to 1/8 scale); the
         # conversion to float comes before any area halving, which then does not round
         out = read_image_level(self.paths[i], self.sizes[i], level, lambda img: self._convert(img, colour))
+        if not colour and self.restoration(i, level) > 0.0:
+            out = restore(out, self.restoration(i, level), self.window_px)
         self.reads += 1
         self._put(key, out)
         return out
+
+    def restoration(self, i: int, level: int) -> float:
+        """The point spread (px of ``level``) undone in image ``i``'s matching band (0: none)."""
+        s = self.spread[i] / 2**level
+        return s if s >= MIN_RESTORE else 0.0
 
     def _convert(self, img: np.ndarray, colour: bool) -> np.ndarray:
         if colour:
@@ -202,6 +235,11 @@ class ImagePyramid:
             b = img if img.ndim == 2 else img[:, :, self.band]
             return np.ascontiguousarray(b.astype(np.float32))
         return luminance(img)
+
+    def band_scale(self, i: int) -> float:
+        """The value of white in image ``i``'s matching band (the luminance of integer data is
+        scaled to 1; a chosen band keeps the file's values)."""
+        return 1.0 if self.band is None else self.value_max(i)
 
     def value_max(self, i: int) -> float:
         """Full-scale value of image ``i`` (255 for 8-bit, 65535 for 16-bit, 1 for float data)."""
@@ -236,13 +274,74 @@ class ImagePyramid:
         return out
 
     def _read_window(self, i, level, x0, y0, w, h, colour) -> np.ndarray:
-        """Windowed read of a rasterio source at a reduced level (its overviews when present)."""
+        """Windowed read of a rasterio source at a reduced level (its overviews when present);
+        a restored band is read with the context its restoration needs and cropped."""
+        s = 0.0 if colour else self.restoration(i, level)
+        if s > 0.0:
+            W, H = self.level_size(i, level)
+            m = restore_margin(s, self.window_px)
+            ax0, ay0 = max(x0 - m, 0), max(y0 - m, 0)
+            ax1, ay1 = min(x0 + w + m, W), min(y0 + h + m, H)
+            img = read_level_window(self.paths[i], self.sizes[i], level, ax0, ay0, ax1 - ax0, ay1 - ay0)
+            self.reads += 1
+            big = restore(self._convert(img, False), s, self.window_px)
+            return big[y0 - ay0 : y0 - ay0 + h, x0 - ax0 : x0 - ax0 + w]
         img = read_level_window(self.paths[i], self.sizes[i], level, x0, y0, w, h)
         self.reads += 1
         out = self._convert(img, colour)
         if out.ndim == 2 and colour:
             out = out[:, :, None]
         return out
+
+
+#: Photos per camera whose point spread :func:`photo_spreads` measures (every k-th of them).
+SPREAD_PHOTOS = 8
+#: Side (px) of the central crop of a photo that its point spread is measured on.
+SPREAD_CROP = 2048
+
+
+def photo_spreads(paths, sizes, cameras, band: int | None = None, progress=None) -> tuple[list[float], dict]:
+    """Per image, the point spread to undo before matching, and a report per camera.
+
+    The photos of one camera (``cameras[i]``, any hashable) share their optics: their spread is
+    the median of :func:`~truortho.core.optics.photo_spread` over up to :data:`SPREAD_PHOTOS` of
+    them (spread evenly over the camera's list), each measured on its central
+    :data:`SPREAD_CROP` pixels square of the matching band, and the part beyond a sharp photo's
+    (:func:`~truortho.core.optics.excess_spread`) is undone. A camera none of whose photos shows
+    enough straight edges is left as it is (0). The report maps each camera (``str``) to
+    ``{"measured": px or None, "photos": measured photos, "restored": px}``. ``progress``
+    (optional) is asked whether to stop between photos.
+    """
+    from ..errors import CancelledError
+
+    n = len(paths)
+    if len(sizes) != n or len(cameras) != n:
+        raise InputError(f"photo_spreads: expected as many sizes and cameras as paths ({n}), "
+                         f"got {len(sizes)} and {len(cameras)}")  # fmt: skip
+    probe = ImagePyramid(paths, sizes, band, max_bytes=0)
+    groups: dict = {}
+    for i, c in enumerate(cameras):
+        groups.setdefault(c, []).append(i)
+    out = [0.0] * n
+    report = {}
+    for cam, idx in groups.items():
+        step = max(1, math.ceil(len(idx) / SPREAD_PHOTOS))
+        vals = []
+        for i in idx[::step]:
+            if progress is not None and progress.cancelled():
+                raise CancelledError("cancelled")
+            W, H = probe.level_size(i, 0)
+            w, h = min(W, SPREAD_CROP), min(H, SPREAD_CROP)
+            g = probe.window(i, 0, (W - w) // 2, (H - h) // 2, w, h)
+            v = photo_spread(g, probe.band_scale(i))
+            if v is not None:
+                vals.append(v)
+        measured = float(np.median(vals)) if vals else None
+        s = excess_spread(min(measured, MAX_SPREAD)) if measured is not None else 0.0
+        for i in idx:
+            out[i] = s
+        report[str(cam)] = {"measured": measured, "photos": len(vals), "restored": s}
+    return out, report
 
 
 def check_images(paths, sizes) -> None:
