@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import CancelledError, InputError
 from ..geometry.frame import parse_crs, require_metric
 from ..grid import RasterGrid
-from ..optics import MAX_SPREAD
+from ..optics import MAX_SPREAD, MIN_RESTORE
 from ..orientation import Orientation, as_orientation
 from ..parallel import (
     EXECUTORS,
@@ -342,8 +342,9 @@ class OsgmResult:
             oblique += int(sysd["points"])
         for cam, d in s.get("point_spread", {}).items():
             if d["restored"] > 0:
-                measured = "" if d["measured"] is None else f" (measured {d['measured']:.2f} px)"
-                text += f"; photos of {cam} restored by a point spread of {d['restored']:.2f} px{measured}"
+                measured = "" if d["measured"] is None else f"measured {d['measured']:.2f} px, "
+                text += (f"; photos of {cam}: point spread {measured}{d['restored']:.2f} px undone at full "
+                         f"resolution (halved per pyramid level, none under {MIN_RESTORE} px)")  # fmt: skip
         if s["completeness"] <= 0.0:
             # an empty DSM reads like a failure; say why and where the result is
             if oblique:

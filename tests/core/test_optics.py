@@ -223,7 +223,7 @@ def test_osgm_restores_blurred_photos_and_edges_gain(tmp_path):
     (cam,) = rep
     assert 1.0 < rep[cam]["measured"] < 1.4 and rep[cam]["photos"] >= 4
     assert rep[cam]["restored"] == pytest.approx(optics.excess_spread(rep[cam]["measured"]))
-    assert "restored by a point spread" in summary
+    assert f"{rep[cam]['restored']:.2f} px undone at full resolution" in summary
     assert rep0 == {"given": {"measured": None, "photos": 0, "restored": 0.0}}
     assert e1 >= e0 + 0.01
     assert n1 <= n0 + 0.05 and f1 >= f0 - 0.005
