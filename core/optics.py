@@ -164,6 +164,10 @@ def _kernel(sigma: float) -> np.ndarray:
 
 def restore_margin(sigma: float, window: int) -> int:
     """Pixels of context :func:`restore` needs around an area to restore it as in the whole image."""
+    if not (math.isfinite(sigma) and 0 <= sigma <= MAX_SPREAD):
+        raise InputError(f"restore_margin: sigma must be in [0, {MAX_SPREAD}] px, got {sigma!r}")
+    if int(window) != window or window < 1:
+        raise InputError(f"restore_margin: window must be a whole number of pixels >= 1, got {window!r}")
     return int(math.ceil(3.0 * sigma)) + int(window) // 2 + 1
 
 

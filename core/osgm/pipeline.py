@@ -142,8 +142,8 @@ class OsgmConfig:
     point_spread : float, optional
         The photos' Gaussian point spread (px) beyond a sharp photo's, undone in the matching band
         before matching (:func:`~truortho.core.optics.restore`: where the detail stands above the
-        noise). None: measured per camera on the photos' straight edges (:func:`photo_spreads`);
-        0: the photos are matched as they are.
+        noise and the photo's typical detail). None: measured per camera on the photos' straight
+        edges (:func:`photo_spreads`); 0: the photos are matched as they are.
     band : int, optional
         0-based band to match on; default the luminance.
     max_levels : int
@@ -900,7 +900,7 @@ class _RunInfo:
             "systems": systems,
             "images": len(self.o.images),
             "image_reads": self.pyr.reads,
-            "point_spread": getattr(self.pyr, "spread_report", {}),
+            "point_spread": self.pyr.spread_report,
             "executor": ex.describe() if hasattr(ex, "describe") else type(ex).__name__,
             "cache_hits": self.cache.hits,
             "cache_tiles_written": self.cache.written,

@@ -27,7 +27,7 @@ from collections import OrderedDict
 
 import numpy as np
 
-from ..errors import InputError
+from ..errors import CancelledError, InputError
 from ..geometry.camera import Camera, _distort_one
 from ..imagery import (
     _use_rasterio,
@@ -312,8 +312,6 @@ def photo_spreads(paths, sizes, cameras, band: int | None = None, progress=None)
     ``{"measured": px or None, "photos": measured photos, "restored": px}``. ``progress``
     (optional) is asked whether to stop between photos.
     """
-    from ..errors import CancelledError
-
     n = len(paths)
     if len(sizes) != n or len(cameras) != n:
         raise InputError(f"photo_spreads: expected as many sizes and cameras as paths ({n}), "
