@@ -1134,8 +1134,9 @@ def test_a_pass_with_its_own_trend_follows_a_weak_roof_down_to_its_eaves():
                         max_images=12, max_view_angle=50.0, median=1, slope_max=2)  # fmt: skip
     err = {}
     for passes in (0, TREND_PASSES):
-        S = aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, passes=passes)
+        S, frac = aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, passes=passes)
         level, _ = select(S, z0, 0.99, valid=valid)
+        level = level if frac is None else level + frac
         err[passes] = np.abs(level - true)[5:-5]
     roof_err = {p: float(np.nanmean(e[:, roof])) for p, e in err.items()}
     eave_err = {p: float(np.nanmean(e[:, 30:36])) for p, e in err.items()}
@@ -1146,9 +1147,9 @@ def test_a_pass_with_its_own_trend_follows_a_weak_roof_down_to_its_eaves():
         assert np.nanmean(e[:, ~roof]) < 0.1  # the ground
     # without slope_max no trend and a single aggregation, whatever ``passes`` says
     flat = dict(params.__dict__, slope_max=0)
-    S0 = aggregate_with_trend(cost, TileParams(**flat), z0, None, None, valid, 0.0, 1.0, passes=3)
-    S1 = aggregate_with_trend(cost, TileParams(**flat), z0, None, None, valid, 0.0, 1.0, passes=0)
-    assert np.array_equal(S0, S1)
+    S0, f0 = aggregate_with_trend(cost, TileParams(**flat), z0, None, None, valid, 0.0, 1.0, passes=3)
+    S1, f1 = aggregate_with_trend(cost, TileParams(**flat), z0, None, None, valid, 0.0, 1.0, passes=0)
+    assert np.array_equal(S0, S1) and f0 is None and f1 is None
     for bad in (-1, 1.5, True):
         with pytest.raises(InputError, match="passes must be an integer >= 0"):
             aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, passes=bad)
@@ -1179,8 +1180,9 @@ def test_trend_from_a_lighter_first_pass_keeps_a_ridge_and_its_eaves():
         cost = np.clip(cost, 0, 1023).astype(np.uint16)
         valid = valid_cells(cost)
         for f in err:
-            S = aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, p1_factor=f)
+            S, frac = aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, p1_factor=f)
             level, _ = select(S, z0, 0.99, valid=valid)
+            level = level if frac is None else level + frac
             err[f].append(np.abs(level - true)[5:-5])
     e1, ef = np.stack(err[1.0]), np.stack(err[TREND_P1])
     assert np.nanmean(ef[..., roof]) < 0.92 * np.nanmean(e1[..., roof])
@@ -1202,6 +1204,92 @@ def test_slope_trend_rejects_bad_input():
     with pytest.raises(InputError, match="slope_max"):
         slope_trend(np.zeros((4, 4)), 0.0, 0.25, 1.5)
     assert slope_trend(np.zeros((4, 4)), 0.0, 0.25, 2).shape == (4, 4)
+
+
+def _ramp_costs(slope, gain, rows=60, cols=120, nd=40, seed=1):
+    """A ramp ``8.3 + slope c`` levels with a V-shaped data term of ``gain`` per level plus noise."""
+    c = np.arange(cols)
+    true = np.broadcast_to((8.3 + slope * c)[None, :], (rows, cols))
+    rng = np.random.default_rng(seed)
+    k = np.arange(nd)[None, None, :]
+    cost = 300 + gain * np.abs(k - true[..., None]) + rng.normal(0, 20, (rows, cols, nd))
+    return true, np.clip(cost, 0, 1023).astype(np.uint16)
+
+
+@pytest.mark.parametrize("slope", [0.13, 0.07])
+def test_gentle_slopes_follow_their_trend_instead_of_forming_terraces(slope):
+    """On a gentle ramp (a level crossed every 8 or 14 cells, below the trend's TREND_MIN_SLOPE),
+    absolute levels make SGM pay P1 at every crossing and nowhere between: terraces. Following the
+    gentle trend of the first pass halves the error and the departure of the slope from the
+    truth's."""
+    from truortho.core.osgm.matching import TREND_MIN_SLOPE, TileParams, aggregate_with_trend
+    from truortho.core.sgm import select, valid_cells
+
+    assert slope < TREND_MIN_SLOPE
+    true, cost = _ramp_costs(slope, 30)
+    z0 = np.zeros(true.shape, np.int32)
+    valid = valid_cells(cost)
+    params = TileParams(radius=2, measure="gradient", p1=256, p2=2048, paths=16, uniqueness=0.99,
+                        max_images=12, max_view_angle=50.0, median=1, slope_max=2)  # fmt: skip
+    rms, dslope = {}, {}
+    for gentle in (False, True):
+        S, frac = aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, sub_level=gentle)
+        assert (frac is None) == (not gentle)
+        level, _ = select(S, z0, 0.99, valid=valid)
+        level = level if frac is None else level + frac
+        inner = (slice(10, -10), slice(15, -15))
+        rms[gentle] = float(np.sqrt(np.nanmean((level - true)[inner] ** 2)))
+        dslope[gentle] = float(np.nanmean(np.abs(np.diff(level[inner], axis=1) - slope)))
+    assert rms[True] < 0.65 * rms[False]
+    assert dslope[True] < 0.65 * dslope[False]
+
+
+def test_level_ground_and_height_steps_keep_absolute_levels():
+    """The gentle trend applies neither on level ground (the flat prior is right there: same
+    aggregation, to the bit) nor next to a height step; it does on a ramp away from the step."""
+    from truortho.core.osgm.matching import GENTLE_SMOOTH, TileParams, aggregate_with_trend, gentle_trend
+    from truortho.core.sgm import valid_cells
+
+    true, cost = _ramp_costs(0.0, 30)
+    z0 = np.zeros(true.shape, np.int32)
+    valid = valid_cells(cost)
+    params = TileParams(radius=2, measure="gradient", p1=256, p2=2048, paths=16, uniqueness=0.99,
+                        max_images=12, max_view_angle=50.0, median=1, slope_max=2)  # fmt: skip
+    S0, f0 = aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, sub_level=False)
+    S1, f1 = aggregate_with_trend(cost, params, z0, None, None, valid, 0.0, 1.0, sub_level=True)
+    assert f0 is None and f1 is None and np.array_equal(S0, S1)
+    # a ramp of 0.1 levels per cell with a 3 m step (12 levels of 0.25 m) at column 60
+    c = np.arange(120)
+    z = np.broadcast_to((10.0 + 0.025 * c + np.where(c >= 60, 3.0, 0.0))[None, :], (50, 120))
+    t, mask = gentle_trend(z, 0.0, 0.25)
+    near = np.abs(c - 59.5) < GENTLE_SMOOTH // 2 + 1
+    assert not mask[:, near].any()
+    assert mask[20:30, 10:45].all() and mask[20:30, 75:110].all()
+    assert np.allclose(t[25, 20:40], z[25, 20:40] / 0.25, atol=1e-9)  # linear: the mean is the value
+    assert np.isnan(t[~mask]).all()
+
+
+def test_shift_levels_interpolates_between_levels():
+    from truortho.core.osgm.matching import shift_levels
+
+    rng = np.random.default_rng(0)
+    cost = rng.integers(0, 1024, (3, 4, 6)).astype(np.uint16)
+    frac = rng.uniform(-0.5, 0.5, (3, 4))
+    frac[0, 0] = 0.0
+    got = shift_levels(cost, frac)
+    k = np.arange(6)
+    for r in range(3):
+        for c in range(4):
+            want = np.interp(k + frac[r, c], k, cost[r, c].astype(np.float64))
+            assert np.abs(got[r, c].astype(np.float64) - want).max() <= 0.5
+    assert np.array_equal(got[0, 0], cost[0, 0])
+    for bad in (np.full((3, 4), 0.6), np.full((3, 4), np.nan), np.zeros((2, 4))):
+        with pytest.raises(InputError, match="shift_levels"):
+            shift_levels(cost, bad)
+    with pytest.raises(InputError, match="gentle_trend"):
+        from truortho.core.osgm.matching import gentle_trend
+
+        gentle_trend(np.zeros(5), 0.0, 0.25)
 
 
 def test_fill_unseen_gives_unseen_heights_a_quantile_of_the_measured():
