@@ -85,6 +85,7 @@ class TileParams:
     slope_max: int = 0  # SGM follows the coarser surface's slopes up to this many levels per cell (0 = off)
     adaptive_p2: bool = True  # P2 adapts to the image gradient of the coarser surface (needs ``guide_z``)
     occlusion_pairs: bool = False  # near a step of the coarser surface, best pairs of the views it leaves
+    sub_level: bool = True  # the last aggregation follows the trend at sub-level precision
 
 
 #: Cells of the box mean that smooths the coarser surface into the trend (:func:`slope_trend`).
@@ -930,7 +931,9 @@ def match_tile(
     if params.slope_max > 0 and guide_z is not None:
         trend = slope_trend(guide_z, z_base, dz, params.slope_max)
     valid = valid_cells(cost) & search
-    S, frac = aggregate_with_trend(cost, params, z0, guide, trend, valid, z_base, dz)
+    S, frac = aggregate_with_trend(
+        cost, params, z0, guide, trend, valid, z_base, dz, sub_level=params.sub_level
+    )
     level, conf = select(S, z0, params.uniqueness, valid=valid)
     del S
     li = np.rint(np.nan_to_num(level, nan=-1e9)).astype(np.int64)

@@ -140,6 +140,11 @@ class OsgmConfig:
         Below the coarsest level, SGM follows the coarser level's slopes up to this many Z levels
         per cell (:func:`~.matching.slope_trend`): slanted roofs are not flattened by P1; 0 = off.
         Independent of ``adaptive_p2``: the coarser surface reaches the tiles when either needs it.
+    sub_level_trend : bool
+        With ``slope_max``, a tile's last aggregation follows its first pass's slopes, and the
+        gentle slopes that the trend leaves alone, at sub-level precision
+        (:func:`~.matching.aggregate_with_trend`): no terraces along the contours. False: whole
+        levels, as before session 27.
     point_spread : float, optional
         The photos' Gaussian point spread (px) beyond a sharp photo's, undone in the matching band
         before matching (:func:`~truortho.core.optics.restore`: where the detail stands above the
@@ -197,6 +202,7 @@ class OsgmConfig:
     refine_edges: bool = True
     occlusion_pairs: bool = True
     slope_max: int = 2
+    sub_level_trend: bool = True
     point_spread: float | None = None
     band: int | None = None
     max_levels: int = 5
@@ -290,6 +296,7 @@ class OsgmConfig:
             slope_max=int(self.slope_max),
             adaptive_p2=bool(self.adaptive_p2),
             occlusion_pairs=bool(self.occlusion_pairs),
+            sub_level=bool(self.sub_level_trend),
         )
 
 

@@ -133,6 +133,10 @@ def test_coarse_levels_keep_near_ties():
         assert p.occlusion_pairs
     off = OsgmConfig(occlusion_pairs=False).tile_params()
     assert plan.level_params(off, 0) == off and not plan.level_params(off, 1).occlusion_pairs
+    # the sub-level trend on every level, unless asked not to
+    assert all(plan.level_params(params, lv).sub_level for lv in (0, 1, 2))
+    whole = OsgmConfig(sub_level_trend=False).tile_params()
+    assert not any(plan.level_params(whole, lv).sub_level for lv in (0, 1, 2))
 
 
 def test_refined_bands_skip_the_heights_between_two_surfaces():
