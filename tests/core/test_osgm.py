@@ -1265,12 +1265,27 @@ def test_level_ground_and_height_steps_keep_absolute_levels():
     # a ramp of 0.1 levels per cell with a 3 m step (12 levels of 0.25 m) at column 60
     c = np.arange(120)
     z = np.broadcast_to((10.0 + 0.025 * c + np.where(c >= 60, 3.0, 0.0))[None, :], (50, 120))
-    t, mask = gentle_trend(z, 0.0, 0.25)
+    t, mask, level = gentle_trend(z, 0.0, 0.25)
     near = np.abs(c - 59.5) < GENTLE_SMOOTH // 2 + 1
     assert not mask[:, near].any()
     assert mask[20:30, 10:45].all() and mask[20:30, 75:110].all()
     assert np.allclose(t[25, 20:40], z[25, 20:40] / 0.25, atol=1e-9)  # linear: the mean is the value
     assert np.isnan(t[~mask]).all()
+
+
+def test_sub_level_offsets_fade_out_towards_level_ground():
+    """The offsets are 0 next to level ground and whole from SUB_LEVEL_TAPER cells away, so a
+    slope's levels meet level ground's whole levels without a step; without level ground they are
+    whole everywhere."""
+    from truortho.core.osgm.matching import SUB_LEVEL_TAPER, _taper
+
+    level = np.zeros((5, 30), bool)
+    level[:, :10] = True
+    w = _taper(level)
+    assert np.all(w[:, :11] == 0.0)  # on level ground and next to it
+    assert np.all(np.diff(w[2, 10:10 + SUB_LEVEL_TAPER + 2]) >= 0.0)
+    assert np.all(w[:, 11 + SUB_LEVEL_TAPER:] == 1.0)
+    assert np.all(_taper(np.zeros((4, 4), bool)) == 1.0)
 
 
 def test_shift_levels_interpolates_between_levels():
