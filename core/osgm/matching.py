@@ -965,7 +965,7 @@ def match_tile(
         edge |= np.isfinite(level) & (gaps[0] <= gaps[1]) & ((li == gaps[0] - 1) | (li == gaps[1] + 1))
     level[edge] = np.nan
     conf[edge] = np.nan
-    if frac is not None:  # the levels of gentle slopes lie frac above the absolute ones
+    if frac is not None:  # the levels of the cells that follow the trend lie frac above the absolute ones
         level = (level + frac).astype(np.float32)
     if params.median > 1:
         level = median_outliers(level, params.median)

@@ -68,10 +68,10 @@ DSM_NODATA = -9999.0
 #: is more photo-consistent than the height itself; 5: the slope trend continued down to a roof's
 #: eaves; 6: the image choice tests frames at the bottom and top of a tile's range too; 7: a second
 #: aggregation with the tile's own trend; 8: that trend from an aggregation with half P1; 9: heights
-#: fewer than two views see cost the median, not COST_MAX; 10: their lower quartile; 11: gentle
-#: slopes follow the first pass's smoothed heights at sub-level precision), so that a cache kept
-#: from an interrupted run of an older version is not reused.
-CACHE_VERSION = 11
+#: fewer than two views see cost the median, not COST_MAX; 10: their lower quartile; 11: the trend
+#: followed at sub-level precision; 12: its offsets faded out next to level ground), so that a
+#: cache kept from an interrupted run of an older version is not reused.
+CACHE_VERSION = 12
 
 
 @dataclass
