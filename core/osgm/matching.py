@@ -557,6 +557,21 @@ def choose_images(
     return out
 
 
+def as_decoded(images: list[TileImage], pyr: ImagePyramid) -> list[TileImage]:
+    """``images`` with their matching bands as the pyramid serves them without its low-pass
+    (:meth:`~.views.ImagePyramid.prefilter_sigma`; the same windows, restored where the photos are):
+    the edge refinement compares 3 x 3 patches at the outlines, which the low-pass would soften.
+    The list itself when no image is low-passed."""
+    if not any(pyr.prefilter_sigma(t.view.index, t.level) > 0.0 for t in images):
+        return images
+    out = []
+    for t in images:
+        h, w = t.window.shape[:2]
+        win = pyr.window(t.view.index, t.level, t.origin[0], t.origin[1], w, h, raw=True)
+        out.append(TileImage(t.view, t.level, t.origin, win, t.angle))
+    return out
+
+
 def _remap(img: TileImage, x0, y0, res, rows, cols, z) -> np.ndarray:
     import cv2
 
@@ -980,5 +995,6 @@ def match_tile(
     if params.edges:
         from .edges import refine_edges
 
-        z = refine_edges(z, images, x0, y0, res, max(1.0, 4.0 * dz), 2.0 * dz, cancelled, conf)
+        decoded = as_decoded(images, pyr)
+        z = refine_edges(z, decoded, x0, y0, res, max(1.0, 4.0 * dz), 2.0 * dz, cancelled, conf)
     return TileResult(z, conf.astype(np.float32), images, evaluated, nd)

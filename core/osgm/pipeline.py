@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import CancelledError, InputError
 from ..geometry.frame import parse_crs, require_metric
 from ..grid import RasterGrid
-from ..optics import MAX_SPREAD, MIN_RESTORE
+from ..optics import MAX_PREFILTER, MAX_SPREAD, MIN_RESTORE
 from ..orientation import Orientation, as_orientation
 from ..parallel import (
     EXECUTORS,
@@ -69,9 +69,12 @@ DSM_NODATA = -9999.0
 #: eaves; 6: the image choice tests frames at the bottom and top of a tile's range too; 7: a second
 #: aggregation with the tile's own trend; 8: that trend from an aggregation with half P1; 9: heights
 #: fewer than two views see cost the median, not COST_MAX; 10: their lower quartile; 11: the trend
-#: followed at sub-level precision; 12: its offsets faded out next to level ground), so that a
-#: cache kept from an interrupted run of an older version is not reused.
-CACHE_VERSION = 12
+#: followed at sub-level precision; 12: its offsets faded out next to level ground; 13: the sharp
+#: photos low-passed before matching, the edge refinement on them as decoded), so that a cache kept
+#: from an interrupted run of an older version is not reused.
+CACHE_VERSION = 13
+#: Default of :attr:`OsgmConfig.prefilter` (Gaussian sigma, px; ``docs/acceptance.md``, session 28).
+DEFAULT_PREFILTER = 0.6
 
 
 @dataclass
@@ -150,6 +153,12 @@ class OsgmConfig:
         before matching (:func:`~truortho.core.optics.restore`: where the detail stands above the
         noise and the photo's typical detail). None: measured per camera on the photos' straight
         edges (:func:`photo_spreads`); 0: the photos are matched as they are.
+    prefilter : float
+        Gaussian sigma (px) by which the matching band of the photos that are not restored is
+        low-passed at full resolution before matching (:func:`~truortho.core.optics.prefilter`):
+        it takes the detail that a bilinear sampler passes differently at every sub-pixel phase
+        (aliasing, JPEG quantisation, noise) out of the cost. The edge refinement compares the
+        photos as decoded. 0: matched as decoded.
     band : int, optional
         0-based band to match on; default the luminance.
     max_levels : int
@@ -204,6 +213,7 @@ class OsgmConfig:
     slope_max: int = 2
     sub_level_trend: bool = True
     point_spread: float | None = None
+    prefilter: float = DEFAULT_PREFILTER
     band: int | None = None
     max_levels: int = 5
     chunk_memory: int = 1 << 30
@@ -246,6 +256,13 @@ class OsgmConfig:
             or not (math.isfinite(ps) and 0 <= ps <= MAX_SPREAD)
         ):
             raise InputError(f"point_spread: expected None (measured) or px in [0, {MAX_SPREAD}], got {ps!r}")
+        pf = self.prefilter
+        if (
+            isinstance(pf, bool)
+            or not isinstance(pf, int | float)
+            or not (math.isfinite(pf) and 0 <= pf <= MAX_PREFILTER)
+        ):
+            raise InputError(f"prefilter: expected a Gaussian sigma in [0, {MAX_PREFILTER}] px, got {pf!r}")
         p1 = DEFAULT_P1 if self.p1 is None else int(self.p1)
         p2 = DEFAULT_P2 if self.p2 is None else int(self.p2)
         if not (0 <= p1 < p2 <= P2_MAX):
@@ -353,6 +370,9 @@ class OsgmResult:
                 measured = "" if d["measured"] is None else f"measured {d['measured']:.2f} px, "
                 text += (f"; photos of {cam}: point spread {measured}{d['restored']:.2f} px undone at full "
                          f"resolution (halved per pyramid level, none under {MIN_RESTORE} px)")  # fmt: skip
+        pf = s.get("prefilter", {})
+        if pf.get("images"):
+            text += f"; {pf['images']} sharp photo(s) low-passed by {pf['sigma']:.2f} px before matching"
         if s["completeness"] <= 0.0:
             # an empty DSM reads like a failure; say why and where the result is
             if oblique:
@@ -492,7 +512,7 @@ def _match_system(
     views = system_views(o, system)
     ctx = TileContext(
         tuple(pyr.paths), tuple(pyr.sizes), pyr.band, pyr.max_bytes, views, pyr.spread, pyr.window_px,
-        pyramid=pyr,
+        pyr.prefilter, pyramid=pyr,
     )  # fmt: skip
     base = ""
     if cache is not None:
@@ -697,7 +717,9 @@ def run_osgm(
     else:
         spread = [float(cfg.point_spread)] * len(paths)
         spread_report = {"given": {"measured": None, "photos": 0, "restored": float(cfg.point_spread)}}
-    pyr = ImagePyramid(paths, sizes, cfg.band, cfg.cache_bytes, spread, 2 * int(cfg.radius) + 1)
+    pyr = ImagePyramid(
+        paths, sizes, cfg.band, cfg.cache_bytes, spread, 2 * int(cfg.radius) + 1, float(cfg.prefilter)
+    )
     pyr.spread_report = spread_report
     # everything a tile's result depends on besides its own inputs: block, parameters, grid, Z surface
     cache_base = Digest(
@@ -909,6 +931,10 @@ class _RunInfo:
             "images": len(self.o.images),
             "image_reads": self.pyr.reads,
             "point_spread": self.pyr.spread_report,
+            "prefilter": {
+                "sigma": self.pyr.prefilter,
+                "images": sum(self.pyr.prefilter_sigma(i, 0) > 0.0 for i in range(len(self.pyr.paths))),
+            },
             "executor": ex.describe() if hasattr(ex, "describe") else type(ex).__name__,
             "cache_hits": self.cache.hits,
             "cache_tiles_written": self.cache.written,

@@ -53,6 +53,8 @@ class TileContext:
     spread: tuple[float, ...] = ()
     #: the restoration's window (``ImagePyramid.window_px``)
     window: int = 5
+    #: the low-pass of the matching band of photos not restored (``ImagePyramid.prefilter``)
+    prefilter: float = 0.0
     #: the run's own pyramid, used in this process; never pickled (workers open their own)
     pyramid: ImagePyramid | None = field(default=None, compare=False)
 
@@ -64,14 +66,14 @@ class TileContext:
     def pyramid_key(self) -> tuple:
         return (
             tuple(self.paths), tuple(tuple(s) for s in self.sizes), self.band, int(self.cache_bytes),
-            tuple(self.spread), int(self.window),
+            tuple(self.spread), int(self.window), float(self.prefilter),
         )  # fmt: skip
 
     def digest(self) -> Digest:
         """Identity of the inputs: image files (path, size, mtime), views, band."""
         d = Digest(
             "osgm-context", [file_identity(p) for p in self.paths], [list(s) for s in self.sizes], self.band,
-            [float(v) for v in self.spread], int(self.window),
+            [float(v) for v in self.spread], int(self.window), float(self.prefilter),
         )  # fmt: skip
         for v in self.views:
             d.add(
@@ -217,7 +219,8 @@ def worker_pyramid(ctx: TileContext) -> ImagePyramid:
     return _PYRAMIDS.get(
         ctx.pyramid_key(),
         lambda: ImagePyramid(
-            list(ctx.paths), list(ctx.sizes), ctx.band, ctx.cache_bytes, ctx.spread or None, ctx.window
+            list(ctx.paths), list(ctx.sizes), ctx.band, ctx.cache_bytes, ctx.spread or None, ctx.window,
+            ctx.prefilter,
         ),
     )
 

@@ -18,6 +18,10 @@ by window at that level (rasterio uses their overviews), other formats are
 decoded once and kept in a least-recently-used cache bounded in bytes. With a point spread per
 image (``spread``), the matching band is restored towards a sharp photo's spread at every level
 (:func:`~truortho.core.optics.restore`, the spread halved per level) before it is served.
+The matching band of a photo that is not restored is low-passed at full resolution by a Gaussian of
+``prefilter`` px (:func:`~truortho.core.optics.prefilter`); the reduced levels are band-limited by
+their reduction already. ``window(..., raw=True)`` serves the band without that low-pass (the edge
+refinement compares 3 x 3 patches at the outlines, which the low-pass would soften).
 """
 
 from __future__ import annotations
@@ -39,7 +43,17 @@ from ..imagery import (
     read_level_window,
 )
 from ..jit import njit
-from ..optics import MAX_SPREAD, MIN_RESTORE, excess_spread, photo_spread, restore, restore_margin
+from ..optics import (
+    MAX_PREFILTER,
+    MAX_SPREAD,
+    MIN_RESTORE,
+    excess_spread,
+    photo_spread,
+    prefilter,
+    prefilter_margin,
+    restore,
+    restore_margin,
+)
 
 
 def monotonic_radius2(camera: Camera, limit: float = 4.0) -> float:
@@ -164,10 +178,14 @@ class ImagePyramid:
         restored.
     window : int
         The restoration's window (px, odd): the matching window's width.
+    prefilter : float
+        Gaussian sigma (px) by which the matching band of every image that is not restored is
+        low-passed at full resolution (:meth:`prefilter_sigma`; 0: none).
     """
 
     def __init__(
-        self, paths, sizes, band: int | None = None, max_bytes: int = 1 << 30, spread=None, window: int = 5
+        self, paths, sizes, band: int | None = None, max_bytes: int = 1 << 30, spread=None, window: int = 5,
+        prefilter: float = 0.0,
     ) -> None:
         self.paths = [str(p) for p in paths]
         self.sizes = [tuple(int(v) for v in s) for s in sizes]
@@ -186,6 +204,16 @@ class ImagePyramid:
         if int(window) != window or window < 1 or window % 2 == 0:
             raise InputError(f"ImagePyramid: window must be an odd number of pixels >= 1, got {window!r}")
         self.window_px = int(window)
+        pf = prefilter
+        if (
+            isinstance(pf, bool)
+            or not isinstance(pf, int | float)
+            or not (math.isfinite(pf) and 0 <= pf <= MAX_PREFILTER)
+        ):
+            raise InputError(
+                f"ImagePyramid: prefilter must be a sigma in [0, {MAX_PREFILTER}] px, got {prefilter!r}"
+            )
+        self.prefilter = float(pf)
         #: what the run measured and restored, per camera (set by the OSGM run; for its statistics)
         self.spread_report: dict = {}
         self._cache: OrderedDict = OrderedDict()
@@ -202,8 +230,9 @@ class ImagePyramid:
             _, old = self._cache.popitem(last=False)
             self._bytes -= old.nbytes
 
-    def _full(self, i: int, level: int, colour: bool) -> np.ndarray:
-        key = (i, level, colour)
+    def _full(self, i: int, level: int, colour: bool, raw: bool = False) -> np.ndarray:
+        lowpass = 0.0 if colour or raw else self.prefilter_sigma(i, level)
+        key = (i, level, colour, lowpass)
         if key in self._cache:
             self._cache.move_to_end(key)
             return self._cache[key]
@@ -212,6 +241,8 @@ class ImagePyramid:
         out = read_image_level(self.paths[i], self.sizes[i], level, lambda img: self._convert(img, colour))
         if not colour and self.restoration(i, level) > 0.0:
             out = restore(out, self.restoration(i, level), self.window_px)
+        if lowpass > 0.0:
+            out = prefilter(out, lowpass)
         self.reads += 1
         self._put(key, out)
         return out
@@ -220,6 +251,13 @@ class ImagePyramid:
         """The point spread (px of ``level``) undone in image ``i``'s matching band (0: none)."""
         s = self.spread[i] / 2**level
         return s if s >= MIN_RESTORE else 0.0
+
+    def prefilter_sigma(self, i: int, level: int) -> float:
+        """The Gaussian sigma (px) image ``i``'s matching band is low-passed by at ``level``: the
+        pyramid's ``prefilter`` at full resolution for a photo that is not restored, else 0."""
+        if level != 0 or self.restoration(i, 0) > 0.0:
+            return 0.0
+        return self.prefilter
 
     def _convert(self, img: np.ndarray, colour: bool) -> np.ndarray:
         if colour:
@@ -253,9 +291,10 @@ class ImagePyramid:
         return level_size(self.sizes[i], level)
 
     def window(
-        self, i: int, level: int, x0: int, y0: int, w: int, h: int, colour: bool = False
+        self, i: int, level: int, x0: int, y0: int, w: int, h: int, colour: bool = False, raw: bool = False
     ) -> np.ndarray:
-        """Window ``[x0, x0 + w) x [y0, y0 + h)`` of level ``level`` (float32, NaN outside the image)."""
+        """Window ``[x0, x0 + w) x [y0, y0 + h)`` of level ``level`` (float32, NaN outside the image);
+        ``raw``: the matching band without the low-pass (:meth:`prefilter_sigma`)."""
         W, H = self.level_size(i, level)
         ix0, iy0, ix1, iy1 = max(x0, 0), max(y0, 0), min(x0 + w, W), min(y0 + h, H)
         nb = 3 if colour else 1
@@ -263,9 +302,9 @@ class ImagePyramid:
         if ix1 <= ix0 or iy1 <= iy0:
             return out
         if self._windowed[i]:
-            part = self._read_window(i, level, ix0, iy0, ix1 - ix0, iy1 - iy0, colour)
+            part = self._read_window(i, level, ix0, iy0, ix1 - ix0, iy1 - iy0, colour, raw)
         else:
-            part = self._full(i, level, colour)[iy0:iy1, ix0:ix1]
+            part = self._full(i, level, colour, raw)[iy0:iy1, ix0:ix1]
         if colour and part.ndim == 2:
             part = part[:, :, None]
         if colour and part.shape[2] == 1:
@@ -273,18 +312,23 @@ class ImagePyramid:
         out[iy0 - y0 : iy1 - y0, ix0 - x0 : ix1 - x0] = part
         return out
 
-    def _read_window(self, i, level, x0, y0, w, h, colour) -> np.ndarray:
+    def _read_window(self, i, level, x0, y0, w, h, colour, raw=False) -> np.ndarray:
         """Windowed read of a rasterio source at a reduced level (its overviews when present);
-        a restored band is read with the context its restoration needs and cropped."""
+        a restored or low-passed band is read with the context that needs and cropped."""
         s = 0.0 if colour else self.restoration(i, level)
-        if s > 0.0:
+        lp = 0.0 if colour or raw else self.prefilter_sigma(i, level)
+        if s > 0.0 or lp > 0.0:
             W, H = self.level_size(i, level)
-            m = restore_margin(s, self.window_px)
+            m = (restore_margin(s, self.window_px) if s > 0.0 else 0) + prefilter_margin(lp)
             ax0, ay0 = max(x0 - m, 0), max(y0 - m, 0)
             ax1, ay1 = min(x0 + w + m, W), min(y0 + h + m, H)
             img = read_level_window(self.paths[i], self.sizes[i], level, ax0, ay0, ax1 - ax0, ay1 - ay0)
             self.reads += 1
-            big = restore(self._convert(img, False), s, self.window_px)
+            big = self._convert(img, False)
+            if s > 0.0:
+                big = restore(big, s, self.window_px)
+            if lp > 0.0:
+                big = prefilter(big, lp)
             return big[y0 - ay0 : y0 - ay0 + h, x0 - ax0 : x0 - ax0 + w]
         img = read_level_window(self.paths[i], self.sizes[i], level, x0, y0, w, h)
         self.reads += 1

@@ -204,6 +204,54 @@ def test_a_gap_is_not_searched_and_a_minimum_beside_it_is_rejected(small_scene):
     assert np.allclose(none.z, full.z, equal_nan=True)
 
 
+
+def test_the_edge_refinement_compares_the_photos_as_decoded(small_scene, monkeypatch):
+    """With the pyramid's low-pass, the sweep matches low-passed windows and the edge refinement
+    gets the same windows as decoded (:func:`~truortho.core.osgm.matching.as_decoded`)."""
+    from truortho.core.osgm import edges
+    from truortho.core.osgm.matching import as_decoded, choose_images, match_tile
+    from truortho.core.osgm.systems import reference_systems, system_views
+    from truortho.core.osgm.views import ImagePyramid
+
+    scene, folder = small_scene
+    o = scene.orientation
+    views = system_views(o, reference_systems(o, "none", 35.0)[0])
+    sizes = [(o.camera_of(im).width, o.camera_of(im).height) for im in o.images]
+    paths = [str(folder / im.name) for im in o.images]
+    plain, pyr = ImagePyramid(paths, sizes), ImagePyramid(paths, sizes, prefilter=0.6)
+    params = OsgmConfig(median=1).tile_params()
+    x0, y0, res, rows, cols = -5.0, 5.0, 0.25, 40, 40
+    z_lo, z_hi = -20.0, 20.0
+    images = choose_images(views, pyr, x0, y0, res, rows, cols, z_lo, z_hi, params)
+    plain_images = choose_images(views, plain, x0, y0, res, rows, cols, z_lo, z_hi, params)
+    assert len(images) >= 2 and [t.view.index for t in images] == [t.view.index for t in plain_images]
+    decoded = as_decoded(images, pyr)
+    for t, d, p in zip(images, decoded, plain_images, strict=True):
+        assert d.origin == t.origin and d.level == t.level and d.view is t.view
+        assert np.array_equal(d.window, p.window, equal_nan=True)
+        if pyr.prefilter_sigma(t.view.index, t.level) > 0:
+            assert not np.allclose(t.window, p.window, equal_nan=True)
+    assert as_decoded(plain_images, plain) is plain_images
+    # match_tile hands the decoded windows to the edge refinement
+    seen = []
+    real = edges.refine_edges
+
+    def spy(z, imgs, *a, **kw):
+        seen.append(imgs)
+        return real(z, imgs, *a, **kw)
+
+    monkeypatch.setattr(edges, "refine_edges", spy)
+    truth = scene.height(np.column_stack([[x0 + 5.0], [y0 - 5.0]]) + scene.offset[:2])[0] - scene.offset[2]
+    z_base, dz = float(np.floor(truth)) - 10.0, 0.25
+    lo = np.zeros((rows, cols), np.int32)
+    hi = np.full((rows, cols), 80, np.int32)
+    match_tile(views, pyr, x0, y0, res, lo, hi, z_base, dz, params)
+    assert len(seen) == 1 and len(seen[0]) >= 2
+    for d in seen[0]:
+        h, w = d.window.shape
+        ref = plain.window(d.view.index, d.level, d.origin[0], d.origin[1], w, h)
+        assert np.array_equal(d.window, ref, equal_nan=True)
+
 def test_reference_systems_of_an_oblique_block():
     scene = make_scene(_small_config(n_oblique=8, image_size=(120, 90), focal_px=150.0))
     o = scene.orientation
