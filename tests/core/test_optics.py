@@ -180,14 +180,33 @@ def test_windowed_reads_restore_as_the_whole_image(tmp_path):
     assert np.abs(a - b).max() < 0.02 and np.abs(a - b).mean() < 2e-3
 
 
+def _dsm_figures(scene, path, gsd: float) -> tuple[float, float, float]:
+    """NMAD (GSD) and the shares within 3 GSD away from and within 2 cells of the building outlines
+    of the DSM at ``path`` against the synthetic ``scene``, over the cells two photos see."""
+    from scipy.ndimage import maximum_filter, minimum_filter
+
+    from truortho.core.rasterio_io import read_raster
+
+    dsm, grid, _ = read_raster(path)
+    X, Y = grid.centres()
+    truth = scene.height(np.column_stack([X.ravel(), Y.ravel()])).reshape(grid.shape)
+    P = np.column_stack([X.ravel(), Y.ravel(), truth.ravel()])
+    n = sum(scene.visibility(P, i, tol=0.05)[0].astype(int) for i in range(len(scene.orientation.images)))
+    seen = n.reshape(grid.shape) >= 2
+    e = dsm - truth
+    ok = np.isfinite(e) & seen
+    step = (maximum_filter(truth, 3) - minimum_filter(truth, 3)) > 1.0
+    edge = maximum_filter(step.astype(np.uint8), 5).astype(bool)
+    good = np.abs(np.nan_to_num(e, nan=1e9)) <= 3 * gsd
+    nmad = 1.4826 * np.median(np.abs(e[ok] - np.median(e[ok]))) / gsd
+    return float(nmad), float(good[seen & ~edge].mean()), float(good[seen & edge].mean())
+
+
 def test_osgm_restores_blurred_photos_and_edges_gain(tmp_path):
     """A nadir block rendered with a 1.2 px optics blur: OSGM measures about that spread and, with
     the restoration, places more cells near building edges within 3 GSD than without it (1.2-1.4
     points more on three such blocks, seeds 1-3), with the same precision away from them."""
-    from scipy.ndimage import maximum_filter, minimum_filter
-
     from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
-    from truortho.core.rasterio_io import read_raster
     from truortho.core.synthetic import SceneConfig, make_scene
 
     cfg = SceneConfig(image_size=(320, 240), focal_px=400.0, seed=1, n_oblique=0, optics_blur=1.2)
@@ -199,21 +218,8 @@ def test_osgm_restores_blurred_photos_and_edges_gain(tmp_path):
         out = OsgmOutputs(dsm=tmp_path / f"dsm_{ps}.tif")
         ocfg = OsgmConfig(resolution=gsd, point_spread=ps, prefilter=0.6 if ps is None else 0.0)
         res = run_osgm(scene.orientation, ocfg, scene.extent_world(), out, tmp_path)
-        dsm, grid, _ = read_raster(tmp_path / f"dsm_{ps}.tif")
-        X, Y = grid.centres()
-        truth = scene.height(np.column_stack([X.ravel(), Y.ravel()])).reshape(grid.shape)
-        P = np.column_stack([X.ravel(), Y.ravel(), truth.ravel()])
-        n = sum(scene.visibility(P, i, tol=0.05)[0].astype(int) for i in range(len(scene.orientation.images)))
-        seen = n.reshape(grid.shape) >= 2
-        e = dsm - truth
-        ok = np.isfinite(e) & seen
-        step = (maximum_filter(truth, 3) - minimum_filter(truth, 3)) > 1.0
-        edge = maximum_filter(step.astype(np.uint8), 5).astype(bool)
-        good = np.abs(np.nan_to_num(e, nan=1e9)) <= 3 * gsd
         figures[name] = (
-            1.4826 * np.median(np.abs(e[ok] - np.median(e[ok]))) / gsd,
-            good[seen & ~edge].mean(),
-            good[seen & edge].mean(),
+            *_dsm_figures(scene, tmp_path / f"dsm_{ps}.tif", gsd),
             res.stats["point_spread"],
             res.summary(),
         )
@@ -322,10 +328,7 @@ def test_osgm_is_more_precise_on_low_passed_photos(tmp_path):
     photos as decoded (seeds 1-3: 0.387 -> 0.318, 0.432 -> 0.350, 0.369 -> 0.299 GSD); cells away
     from edges are within 3 GSD as often, and the edge cells within 1.3 points (the edge refinement
     compares the photos as decoded)."""
-    from scipy.ndimage import maximum_filter, minimum_filter
-
     from truortho.core.osgm import OsgmConfig, OsgmOutputs, run_osgm
-    from truortho.core.rasterio_io import read_raster
     from truortho.core.synthetic import SceneConfig, make_scene
 
     cfg = SceneConfig(image_size=(320, 240), focal_px=400.0, seed=1, n_oblique=0, jpeg_quality=70,
@@ -339,19 +342,7 @@ def test_osgm_is_more_precise_on_low_passed_photos(tmp_path):
         ocfg = OsgmConfig(resolution=gsd, prefilter=pf)
         summary = run_osgm(scene.orientation, ocfg, scene.extent_world(), out, tmp_path).summary()
         assert ("low-passed by 0.60 px before matching" in summary) == (pf > 0), summary
-        dsm, grid, _ = read_raster(tmp_path / f"dsm_{pf}.tif")
-        X, Y = grid.centres()
-        truth = scene.height(np.column_stack([X.ravel(), Y.ravel()])).reshape(grid.shape)
-        P = np.column_stack([X.ravel(), Y.ravel(), truth.ravel()])
-        n = sum(scene.visibility(P, i, tol=0.05)[0].astype(int) for i in range(len(scene.orientation.images)))
-        seen = n.reshape(grid.shape) >= 2
-        e = dsm - truth
-        ok = np.isfinite(e) & seen
-        step = (maximum_filter(truth, 3) - minimum_filter(truth, 3)) > 1.0
-        edge = maximum_filter(step.astype(np.uint8), 5).astype(bool)
-        good = np.abs(np.nan_to_num(e, nan=1e9)) <= 3 * gsd
-        nmad = 1.4826 * np.median(np.abs(e[ok] - np.median(e[ok]))) / gsd
-        figures[pf] = (nmad, good[seen & ~edge].mean(), good[seen & edge].mean())
+        figures[pf] = _dsm_figures(scene, tmp_path / f"dsm_{pf}.tif", gsd)
     print("\n" + "\n".join(f"prefilter {k}: NMAD {v[0]:.3f} GSD, flat3 {v[1]:.4f}, edge3 {v[2]:.4f}"
                            for k, v in figures.items()))  # fmt: skip
     (n0, f0, e0), (n1, f1, e1) = figures[0.0], figures[0.6]
