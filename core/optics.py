@@ -37,6 +37,7 @@ Pure numpy and OpenCV (no qgis). Inputs are validated; errors are :class:`InputE
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -231,10 +232,18 @@ def restore(grey, sigma: float, window: int, noise: float | None = None) -> np.n
     return out
 
 
+def check_prefilter(sigma, where: str) -> float:
+    """``sigma`` as a float if it is a Gaussian sigma :func:`prefilter` takes (a real number in
+    ``[0, MAX_PREFILTER]`` px, not a bool); else an :class:`InputError` that starts with ``where``."""
+    ok = isinstance(sigma, numbers.Real) and not isinstance(sigma, bool | np.bool_)
+    if not (ok and math.isfinite(sigma) and 0 <= sigma <= MAX_PREFILTER):
+        raise InputError(f"{where}: expected a Gaussian sigma in [0, {MAX_PREFILTER}] px, got {sigma!r}")
+    return float(sigma)
+
+
 def prefilter_margin(sigma: float) -> int:
     """Pixels of context :func:`prefilter` needs around an area to filter it as in the whole image."""
-    if not (math.isfinite(sigma) and 0 <= sigma <= MAX_PREFILTER):
-        raise InputError(f"prefilter_margin: sigma must be in [0, {MAX_PREFILTER}] px, got {sigma!r}")
+    sigma = check_prefilter(sigma, "prefilter_margin: sigma")
     return int(math.ceil(3.0 * sigma)) + 1 if sigma > 0 else 0
 
 
@@ -245,8 +254,7 @@ def prefilter(grey, sigma: float) -> np.ndarray:
     import cv2
 
     g = _grey(grey, "prefilter")
-    if not (math.isfinite(sigma) and 0 <= sigma <= MAX_PREFILTER):
-        raise InputError(f"prefilter: sigma must be in [0, {MAX_PREFILTER}] px, got {sigma!r}")
+    sigma = check_prefilter(sigma, "prefilter: sigma")
     if sigma == 0:
         return g.copy()
     kern = _kernel(sigma)

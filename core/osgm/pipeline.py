@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import CancelledError, InputError
 from ..geometry.frame import parse_crs, require_metric
 from ..grid import RasterGrid
-from ..optics import MAX_PREFILTER, MAX_SPREAD, MIN_RESTORE
+from ..optics import MAX_SPREAD, MIN_RESTORE, check_prefilter
 from ..orientation import Orientation, as_orientation
 from ..parallel import (
     EXECUTORS,
@@ -256,13 +256,7 @@ class OsgmConfig:
             or not (math.isfinite(ps) and 0 <= ps <= MAX_SPREAD)
         ):
             raise InputError(f"point_spread: expected None (measured) or px in [0, {MAX_SPREAD}], got {ps!r}")
-        pf = self.prefilter
-        if (
-            isinstance(pf, bool)
-            or not isinstance(pf, int | float)
-            or not (math.isfinite(pf) and 0 <= pf <= MAX_PREFILTER)
-        ):
-            raise InputError(f"prefilter: expected a Gaussian sigma in [0, {MAX_PREFILTER}] px, got {pf!r}")
+        check_prefilter(self.prefilter, "prefilter")
         p1 = DEFAULT_P1 if self.p1 is None else int(self.p1)
         p2 = DEFAULT_P2 if self.p2 is None else int(self.p2)
         if not (0 <= p1 < p2 <= P2_MAX):

@@ -44,9 +44,9 @@ from ..imagery import (
 )
 from ..jit import njit
 from ..optics import (
-    MAX_PREFILTER,
     MAX_SPREAD,
     MIN_RESTORE,
+    check_prefilter,
     excess_spread,
     photo_spread,
     prefilter,
@@ -204,16 +204,7 @@ class ImagePyramid:
         if int(window) != window or window < 1 or window % 2 == 0:
             raise InputError(f"ImagePyramid: window must be an odd number of pixels >= 1, got {window!r}")
         self.window_px = int(window)
-        pf = prefilter
-        if (
-            isinstance(pf, bool)
-            or not isinstance(pf, int | float)
-            or not (math.isfinite(pf) and 0 <= pf <= MAX_PREFILTER)
-        ):
-            raise InputError(
-                f"ImagePyramid: prefilter must be a sigma in [0, {MAX_PREFILTER}] px, got {prefilter!r}"
-            )
-        self.prefilter = float(pf)
+        self.prefilter = check_prefilter(prefilter, "ImagePyramid: prefilter")
         #: what the run measured and restored, per camera (set by the OSGM run; for its statistics)
         self.spread_report: dict = {}
         self._cache: OrderedDict = OrderedDict()
